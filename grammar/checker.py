@@ -1,0 +1,508 @@
+"""Name resolution and static checks of one parsed module, before any geometry is made.
+
+The checker walks the tree once and collects every problem as a :class:`Diagnostic`; it does not
+stop at the first.  Imports are resolved by :mod:`bgr.grammar.loader`, which hands the checker
+the already-checked imported modules as :class:`Grammar` objects.
+"""
+
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass, field
+
+from . import nodes as n
+from .errors import Diagnostic, source_line, suggest
+from .registry import (AXES, AXIS, AXIS_NAMES, BUILTIN_NAMES, BUILTINS, COLOR, COMP_KIND, COMP_KINDS,
+                       COMP_SELECTORS, GEOMETRY, NUMBER, OFFSET_SELECTORS, OPERATIONS, PRIMITIVES,
+                       REQUIRED, ROOF_KIND, ROOF_KINDS, SIZE, STRING, Op)
+
+KNOWN_VERSIONS = (1,)
+_COLOR_RE = re.compile(r"#[0-9a-fA-F]{6}\Z")
+_SYMBOL_KINDS = {AXIS: AXIS_NAMES, COMP_KIND: COMP_KINDS, ROOF_KIND: ROOF_KINDS}
+_RESERVED_ALIASES = {"scope", "split", "comp", "stdlib"}
+
+
+@dataclass
+class Grammar:
+    """A checked module: its tree, its symbol tables and its imported modules.
+
+    Names are resolved per module: a rule of an imported module refers to that module's own
+    rules, attrs and functions; the importer reaches them as ``alias.Name``.
+    """
+
+    path: str
+    module: n.Module
+    rules: dict[str, n.Rule] = field(default_factory=dict)
+    terminals: dict[str, n.Pos] = field(default_factory=dict)
+    attrs: dict[str, n.Attr] = field(default_factory=dict)
+    consts: dict[str, n.Const] = field(default_factory=dict)
+    funcs: dict[str, n.Func] = field(default_factory=dict)
+    assets: dict[str, n.Asset] = field(default_factory=dict)
+    imports: dict[str, "Grammar"] = field(default_factory=dict)
+    start: str | None = None
+    version: int = 1
+
+    def lookup_module(self, dotted: str) -> tuple["Grammar", str]:
+        """Split ``alias.Name`` into (module, member); a plain name is this module's own."""
+        if "." in dotted:
+            alias, member = dotted.split(".", 1)
+            if alias in self.imports:
+                return self.imports[alias], member
+        return self, dotted
+
+
+class Checker:
+    """Checks one module.  ``check()`` returns the diagnostics; the Grammar is filled in."""
+
+    def __init__(self, grammar: Grammar, import_errors: dict[str, bool] | None = None) -> None:
+        self.g = grammar
+        self.source = grammar.module.source
+        self.diagnostics: list[Diagnostic] = []
+        # aliases whose import failed: names under them are not reported a second time
+        self.broken_aliases = set(k for k, bad in (import_errors or {}).items() if bad)
+
+    # ---- reporting ------------------------------------------------------------------------
+    def error(self, pos: n.Pos, message: str, hint: str | None = None, length: int | None = None) -> None:
+        if length is None:
+            length = pos.end_column - pos.column if pos.end_line == pos.line else 1
+        self.diagnostics.append(Diagnostic(self.g.path, pos.line, pos.column, message, hint,
+                                           source_line(self.source, pos.line), max(length, 1)))
+
+    # ---- entry point ----------------------------------------------------------------------
+    def check(self) -> list[Diagnostic]:
+        self.collect()
+        for item in self.g.module.items:
+            if isinstance(item, n.Attr) or isinstance(item, n.Const):
+                self.expr(item.value, set(), in_rule=False)
+            elif isinstance(item, n.Func):
+                self.expr(item.body, set(item.params), in_rule=True)
+            elif isinstance(item, n.Rule):
+                self.rule(item)
+        self.value_cycles()
+        return self.diagnostics
+
+    # ---- declarations ---------------------------------------------------------------------
+    def collect(self) -> None:
+        g = self.g
+        first_seen: dict[tuple[str, str], n.Pos] = {}
+
+        def declare(space: str, name: str, pos: n.Pos, what: str) -> bool:
+            key = (space, name)
+            if key in first_seen:
+                self.error(pos, f"duplicate {what} '{name}'",
+                           f"'{name}' is already defined on line {first_seen[key].line}")
+                return False
+            first_seen[key] = pos
+            return True
+
+        versions = starts = 0
+        for item in g.module.items:
+            if isinstance(item, n.Version):
+                versions += 1
+                if versions > 1:
+                    self.error(item.pos, "more than one 'version' declaration")
+                elif item.number not in KNOWN_VERSIONS:
+                    shown = int(item.number) if item.number.is_integer() else item.number
+                    self.error(item.pos, f"unknown language version {shown}",
+                               "this bgr reads version 1: write 'version 1' or leave the line out")
+                else:
+                    g.version = int(item.number)
+            elif isinstance(item, n.Rule):
+                if item.name in OPERATIONS:
+                    self.error(item.pos, f"'{item.name}' is an operation and cannot name a rule",
+                               "choose another name, e.g. a capitalised one", len(item.name))
+                elif declare("rule", item.name, item.pos, "rule"):
+                    g.rules[item.name] = item
+                self.unique_params(item.params, item.pos, "rule")
+            elif isinstance(item, n.TerminalDecl):
+                for name in item.names:
+                    if declare("rule", name, item.pos, "rule or terminal"):
+                        g.terminals[name] = item.pos
+            elif isinstance(item, (n.Attr, n.Const)):
+                what = "attr" if isinstance(item, n.Attr) else "const"
+                if item.name in BUILTIN_NAMES:
+                    self.error(item.pos, f"'{item.name}' is a built-in name and cannot be redefined")
+                elif declare("value", item.name, item.pos, "attr or const"):
+                    (g.attrs if what == "attr" else g.consts)[item.name] = item
+            elif isinstance(item, n.Func):
+                if item.name in BUILTINS:
+                    self.error(item.pos, f"'{item.name}' is a built-in function and cannot be redefined")
+                elif declare("func", item.name, item.pos, "func"):
+                    g.funcs[item.name] = item
+                self.unique_params(item.params, item.pos, "func")
+            elif isinstance(item, n.Asset):
+                if item.name in PRIMITIVES:
+                    self.error(item.pos, f"'{item.name}' is a built-in primitive and cannot name an asset")
+                elif declare("asset", item.name, item.pos, "asset"):
+                    g.assets[item.name] = item
+            elif isinstance(item, n.Import):
+                if item.alias in _RESERVED_ALIASES:
+                    self.error(item.pos, f"'{item.alias}' is reserved and cannot be an import alias",
+                               f"write e.g. 'as {item.alias[:3]}_lib'")
+                else:
+                    declare("alias", item.alias, item.pos, "import alias")
+            elif isinstance(item, n.Start):
+                starts += 1
+                if starts > 1:
+                    self.error(item.pos, "more than one 'start' declaration")
+                else:
+                    g.start = item.name
+        # the start rule is checked once every rule is known
+        for item in g.module.items:
+            if isinstance(item, n.Start) and item.name == g.start and item.name not in g.rules:
+                hint = suggest(item.name, g.rules) or ("the file has no rules" if not g.rules else None)
+                self.error(item.pos, f"start rule '{item.name}' is not defined", hint)
+                break
+        if g.start is None and g.rules:
+            g.start = next(iter(g.rules))
+
+    def unique_params(self, params: list[str], pos: n.Pos, what: str) -> None:
+        seen = set()
+        for p in params:
+            if p in seen:
+                self.error(pos, f"parameter '{p}' appears twice in this {what}")
+            seen.add(p)
+
+    # ---- rules ----------------------------------------------------------------------------
+    def rule(self, rule: n.Rule) -> None:
+        local = set(rule.params)
+        body = rule.body
+        if isinstance(body, n.Sequence):
+            self.sequence(body, local)
+        elif isinstance(body, n.Stochastic):
+            total = 0.0
+            for choice in body.choices:
+                if choice.prob is None:
+                    self.sequence(choice.body, local)
+                    continue
+                self.expr(choice.prob, local, in_rule=True)
+                if isinstance(choice.prob, n.Number):
+                    if choice.prob.value < 0:
+                        self.error(choice.prob.pos, "a probability cannot be negative")
+                    total += choice.prob.value
+                    if total > 100 + 1e-9:
+                        self.error(choice.prob.pos, f"the percentages add up to {total:g}%, over 100%",
+                                   "the choices of one rule share 100%; 'else' takes what is left")
+                self.sequence(choice.body, local)
+        else:
+            for case in body.cases:
+                if case.cond is not None:
+                    self.expr(case.cond, local, in_rule=True)
+                self.sequence(case.body, local)
+
+    def sequence(self, seq: n.Sequence, local: set[str]) -> None:
+        for step in seq.steps:
+            self.step(step, local)
+
+    def step(self, step, local: set[str]) -> None:
+        if isinstance(step, n.Operation):
+            self.operation(step, local)
+        elif isinstance(step, n.Successor):
+            self.successor(step, local)
+        elif isinstance(step, n.Push):
+            for inner in step.steps:
+                self.step(inner, local)
+
+    def successor(self, step: n.Successor, local: set[str]) -> None:
+        for arg in step.args:
+            self.arg(arg, local, relative_ok=False)
+        module, member = self.g.lookup_module(step.name)
+        if module is not self.g or "." in step.name:
+            alias = step.name.split(".", 1)[0]
+            if alias in self.broken_aliases:
+                return
+            if module is self.g:  # dotted, but the alias is no import
+                self.unknown_alias(alias, step.pos)
+                return
+        if member in module.rules:
+            params = module.rules[member].params
+            if len(step.args) != len(params):
+                want = f"{member}({', '.join(params)})" if params else member
+                self.error(step.pos, f"rule '{step.name}' takes {_count(len(params), 'argument')}, "
+                           f"given {len(step.args)}", f"it is declared as {want}", len(step.name))
+        elif member in module.terminals:
+            if step.args:
+                self.error(step.pos, f"terminal '{step.name}' takes no arguments", length=len(step.name))
+        elif module is self.g and member in OPERATIONS:
+            op = OPERATIONS[member]
+            self.error(step.pos, f"operation '{member}' needs its arguments", f"write {op.usage()}",
+                       len(member))
+        else:
+            known = list(module.rules) + list(module.terminals)
+            if module is self.g:
+                known += list(OPERATIONS) if member[:1].islower() else []
+            hint = suggest(member, known)
+            if hint is None and module is self.g:
+                hint = f"define it with '{member} --> ...' or declare it with 'terminal {member}'"
+            where = f"module '{step.name.split('.')[0]}' has no rule" if module is not self.g else "unknown rule"
+            self.error(step.pos, f"{where} '{member}'", hint, len(step.name))
+
+    def unknown_alias(self, alias: str, pos: n.Pos) -> None:
+        hint = suggest(alias, self.g.imports) or f"import it first: import stdlib.{alias} as {alias}"
+        self.error(pos, f"unknown module '{alias}'", hint, len(alias))
+
+    # ---- operations -----------------------------------------------------------------------
+    def operation(self, step: n.Operation, local: set[str]) -> None:
+        op = OPERATIONS[step.name]
+        signature = self.pick_signature(op, step)
+        if signature is not None:
+            for arg, param in zip(step.args, signature):
+                self.op_arg(arg, param.kind, param.name, op, local)
+        else:
+            for arg in step.args:
+                self.arg(arg, local, relative_ok=True)
+        if op.block is None:
+            if step.block is not None:  # the grammar lets any call carry a block
+                self.error(step.block.pos, f"'{op.name}' takes no {{ }} block")
+            return
+        if step.block is None:
+            self.error(step.pos, f"'{op.name}' needs a {{ ... }} block", f"for example: {op.example}",
+                       len(op.name))
+            return
+        if step.block.repeat and op.block != "split":
+            self.error(step.block.pos, f"only split blocks repeat; '{op.name}' {{ ... }}* has a '*'")
+        self.block_entries(step.block.entries, op, local, in_group=False)
+
+    def pick_signature(self, op: Op, step: n.Operation):
+        count = len(step.args)
+        for sig, (least, most) in zip(op.signatures, op.arities()):
+            if least <= count <= most:
+                return sig
+        counts = " or ".join(str(a) if a == b else f"{a} to {b}" for a, b in op.arities())
+        self.error(step.pos, f"'{op.name}' takes {counts} arguments, given {count}",
+                   f"write {op.usage()}", len(op.name))
+        return None
+
+    def op_arg(self, arg, kind: str, pname: str, op: Op, local: set[str]) -> None:
+        if kind in _SYMBOL_KINDS or kind in (AXES, GEOMETRY):
+            if not isinstance(arg, n.Name):
+                allowed = self.allowed_symbols(kind)
+                self.error(arg.pos, f"the {pname} of '{op.name}' is a bare word, one of {allowed}",
+                           f"for example: {op.example}")
+                return
+            word = arg.name
+            if kind in _SYMBOL_KINDS:
+                if word not in _SYMBOL_KINDS[kind]:
+                    self.error(arg.pos, f"unknown {kind} '{word}'",
+                               suggest(word, _SYMBOL_KINDS[kind]) or f"use one of {self.allowed_symbols(kind)}")
+            elif kind == AXES:
+                if not word or set(word) - set("xyz") or len(set(word)) != len(word):
+                    self.error(arg.pos, f"'{word}' is not a set of axes",
+                               "write the axes as one word of x, y and z, e.g. center(xz)")
+            else:  # GEOMETRY
+                module, member = self.g.lookup_module(word)
+                if member in PRIMITIVES and module is self.g:
+                    return
+                if "." in word and word.split(".", 1)[0] in self.broken_aliases:
+                    return
+                if member not in module.assets:
+                    known = list(PRIMITIVES) + list(self.g.assets)
+                    self.error(arg.pos, f"unknown primitive or asset '{word}'",
+                               suggest(word, known) or "declare it: asset NAME = \"path/to/mesh.glb\"")
+            return
+        if isinstance(arg, n.Relative) and kind != SIZE:
+            self.error(arg.pos, f"a relative size ('f) is not allowed as the {pname} of '{op.name}'",
+                       "relative sizes go in s(), t() and split sizes")
+            return
+        self.arg(arg, local, relative_ok=True)
+        expr = arg.expr if isinstance(arg, n.Relative) else arg
+        if kind in (NUMBER, SIZE) and isinstance(expr, (n.String, n.Bool)):
+            self.error(expr.pos, f"the {pname} of '{op.name}' must be a number")
+        elif kind == STRING and isinstance(expr, (n.Number, n.Bool)):
+            self.error(expr.pos, f"the {pname} of '{op.name}' must be a string",
+                       f"for example: {op.example}")
+        elif kind == COLOR:
+            if isinstance(expr, n.String) and not _COLOR_RE.match(expr.value):
+                self.error(expr.pos, f"'{expr.value}' is not a colour",
+                           'write "#rrggbb" with six hexadecimal digits, or three numbers in 0..1')
+            elif isinstance(expr, (n.Number, n.Bool)):
+                self.error(expr.pos, "a single colour argument is a \"#rrggbb\" string",
+                           "or give three numbers: color(r, g, b)")
+
+    def allowed_symbols(self, kind: str) -> str:
+        if kind == AXES:
+            return "x, y, z, xy, xz, yz, xyz"
+        if kind == GEOMETRY:
+            return ", ".join(list(PRIMITIVES) + list(self.g.assets))
+        return ", ".join(_SYMBOL_KINDS[kind])
+
+    def block_entries(self, entries, op: Op, local: set[str], in_group: bool) -> None:
+        for entry in entries:
+            if isinstance(entry, n.Group):
+                if op.block != "split":
+                    self.error(entry.pos, f"repeat groups {{ ... }}* belong in split blocks, not in '{op.name}'")
+                else:
+                    self.block_entries(entry.entries, op, local, in_group=True)
+                continue
+            if op.block == "split":
+                self.expr(entry.key, local, in_rule=True)
+                if isinstance(entry.key, (n.String, n.Bool)):
+                    self.error(entry.key.pos, "a split size must be a number")
+            else:
+                self.selector(entry, op, local)
+            self.sequence(entry.body, local)
+
+    def selector(self, entry: n.Entry, op: Op, local: set[str]) -> None:
+        allowed = COMP_SELECTORS if op.block == "comp" else OFFSET_SELECTORS
+        key = entry.key
+        if entry.kind != "abs":
+            self.error(entry.pos, f"'{op.name}' selectors have no size prefix",
+                       f"write e.g. '{allowed[0]}: A'")
+            return
+        if isinstance(key, n.Name) and key.name in allowed:
+            return
+        if op.block == "comp" and isinstance(key, n.Call) and key.name == "face":
+            if len(key.args) != 1:
+                self.error(key.pos, "face() takes one argument, the face index")
+            else:
+                self.expr(key.args[0], local, in_rule=True)
+            return
+        word = key.name if isinstance(key, (n.Name, n.Call)) else None
+        extra = ", face(i)" if op.block == "comp" else ""
+        hint = suggest(word, allowed) if word else None
+        self.error(key.pos, f"unknown {op.name} selector" + (f" '{word}'" if word else ""),
+                   hint or f"use one of {', '.join(allowed)}{extra}")
+
+    # ---- expressions ----------------------------------------------------------------------
+    def arg(self, arg, local: set[str], relative_ok: bool) -> None:
+        if isinstance(arg, n.Relative):
+            if not relative_ok:
+                self.error(arg.pos, "a relative size ('f) is not allowed here",
+                           "relative sizes go in s(), t() and split sizes")
+            self.expr(arg.expr, local, in_rule=True)
+        else:
+            self.expr(arg, local, in_rule=True)
+
+    def expr(self, e, local: set[str], in_rule: bool) -> None:
+        """Resolve every name and call in an expression (iteratively: chains can be long)."""
+        stack = [e]
+        while stack:
+            e = stack.pop()
+            if isinstance(e, n.Name):
+                self.name(e, local, in_rule)
+            elif isinstance(e, n.Binary):
+                stack += (e.right, e.left)
+            elif isinstance(e, n.Unary):
+                stack.append(e.operand)
+            elif isinstance(e, n.Ternary):
+                stack += (e.otherwise, e.then, e.cond)
+            elif isinstance(e, n.Call):
+                self.call(e)
+                stack += reversed(e.args)
+            elif isinstance(e, n.Relative):
+                self.error(e.pos, "a relative size ('f) is not allowed here")
+
+    def name(self, e: n.Name, local: set[str], in_rule: bool) -> None:
+        name = e.name
+        if name in local or name in self.g.attrs or name in self.g.consts:
+            return
+        if name in BUILTIN_NAMES:
+            if not in_rule and name != "seed":
+                self.error(e.pos, f"'{name}' is only known while deriving a shape",
+                           "use it in a rule or a func, not in an attr or const")
+            return
+        if "." in name:
+            alias, member = name.split(".", 1)
+            if alias in self.broken_aliases:
+                return
+            if alias in self.g.imports:
+                module = self.g.imports[alias]
+                if member in module.attrs or member in module.consts:
+                    return
+                hint = suggest(member, list(module.attrs) + list(module.consts))
+                self.error(e.pos, f"module '{alias}' has no attr or const '{member}'", hint)
+                return
+            if alias in ("scope", "split", "comp"):
+                known = [k for k in BUILTIN_NAMES if k.startswith(alias + ".")]
+                self.error(e.pos, f"unknown name '{name}'", suggest(name, known) or f"known: {', '.join(known)}")
+                return
+            self.unknown_alias(alias, e.pos)
+            return
+        if name in self.g.rules or name in self.g.terminals:
+            self.error(e.pos, f"'{name}' is a rule, not a value",
+                       "rules are applied in a rule body, outside expressions")
+            return
+        known = list(local) + list(self.g.attrs) + list(self.g.consts) + list(BUILTIN_NAMES)
+        hint = suggest(name, known)
+        if hint is None and (name in AXIS_NAMES or name in ROOF_KINDS or name in PRIMITIVES):
+            hint = "bare words like this are only arguments of split, roof, i and similar operations"
+        self.error(e.pos, f"unknown name '{name}'", hint, len(name))
+
+    def call(self, e: n.Call) -> None:
+        name, count = e.name, len(e.args)
+        if name in BUILTINS:
+            b = BUILTINS[name]
+            if count < b.least or (b.most is not None and count > b.most):
+                want = str(b.least) if b.least == b.most else (
+                    f"{b.least} or more" if b.most is None else f"{b.least} to {b.most}")
+                self.error(e.pos, f"'{name}' takes {want} arguments, given {count}", b.doc, len(name))
+            return
+        module, member = self.g.lookup_module(name)
+        if "." in name and name.split(".", 1)[0] in self.broken_aliases:
+            return
+        if "." in name and module is self.g:
+            self.unknown_alias(name.split(".", 1)[0], e.pos)
+            return
+        if member in module.funcs:
+            params = module.funcs[member].params
+            if count != len(params):
+                self.error(e.pos, f"function '{name}' takes {_count(len(params), 'argument')}, given {count}",
+                           f"it is declared as {member}({', '.join(params)})", len(name))
+            return
+        if module is self.g and name in OPERATIONS:
+            self.error(e.pos, f"'{name}' is an operation, not a function; it cannot be used in an expression",
+                       length=len(name))
+            return
+        if module is self.g and (name in self.g.rules or name in self.g.terminals):
+            self.error(e.pos, f"'{name}' is a rule, not a function", length=len(name))
+            return
+        known = list(module.funcs) + (list(BUILTINS) if module is self.g else [])
+        self.error(e.pos, f"unknown function '{name}'", suggest(member, known), len(name))
+
+    def value_cycles(self) -> None:
+        """attr a = b + 1; attr b = a: report a definition cycle among attrs and consts."""
+        values = {**self.g.attrs, **self.g.consts}
+        deps = {name: {x.name for x in _names(item.value) if x.name in values} for name, item in values.items()}
+        state: dict[str, int] = {}
+        for root in deps:
+            if state.get(root):
+                continue
+            stack = [(root, iter(sorted(deps[root])))]
+            path = [root]
+            state[root] = 1
+            while stack:
+                node, children = stack[-1]
+                child = next(children, None)
+                if child is None:
+                    state[node] = 2
+                    stack.pop()
+                    path.pop()
+                elif state.get(child) == 1:
+                    cycle = path[path.index(child):] + [child]
+                    self.error(values[child].pos, "attrs and consts define each other in a cycle: "
+                               + " -> ".join(cycle))
+                    state[child] = 2
+                elif not state.get(child):
+                    state[child] = 1
+                    stack.append((child, iter(sorted(deps[child]))))
+                    path.append(child)
+
+
+def _names(e):
+    stack = [e]
+    while stack:
+        e = stack.pop()
+        if isinstance(e, n.Name):
+            yield e
+        elif isinstance(e, n.Binary):
+            stack += (e.left, e.right)
+        elif isinstance(e, n.Unary):
+            stack.append(e.operand)
+        elif isinstance(e, n.Ternary):
+            stack += (e.cond, e.then, e.otherwise)
+        elif isinstance(e, n.Call):
+            stack += e.args
+
+
+def _count(k: int, word: str) -> str:
+    return f"{k} {word}" if k == 1 else f"{k} {word}s"

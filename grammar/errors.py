@@ -1,0 +1,85 @@
+"""Errors a user can act on: ``path:line:col: error: message``, the source line, a caret, a hint.
+
+Every failure that reaches a user is a :class:`BgrError`.  One error may carry several
+:class:`Diagnostic` entries (the checker reports every problem it finds, not only the first);
+the error's own ``path``, ``line`` and ``column`` are those of the first diagnostic.
+"""
+
+from __future__ import annotations
+
+import difflib
+from dataclasses import dataclass
+from typing import Iterable
+
+
+@dataclass
+class Diagnostic:
+    path: str
+    line: int
+    column: int
+    message: str
+    hint: str | None = None
+    source_line: str | None = None
+    length: int = 1  # how many characters the caret underlines
+
+    def render(self) -> str:
+        where = f"{self.path}:{self.line}:{self.column}" if self.line else self.path
+        out = [f"{where}: error: {self.message}"]
+        if self.source_line is not None and self.line:
+            text = self.source_line.rstrip("\r\n")
+            gutter = f"{self.line:>5} | "
+            out.append(gutter + text)
+            # keep tabs so that the caret lines up under tab-indented code
+            lead = "".join(c if c == "\t" else " " for c in text[: max(self.column - 1, 0)])
+            width = max(1, min(self.length, max(len(text) - self.column + 1, 1)))
+            out.append(" " * (len(gutter) - 2) + "| " + lead + "^" + "~" * (width - 1))
+        if self.hint:
+            out.append(f"hint: {self.hint}")
+        return "\n".join(out)
+
+
+class BgrError(Exception):
+    """The one exception type users of bgr see: bad input, with where and why."""
+
+    def __init__(self, diagnostics: Diagnostic | Iterable[Diagnostic] | str, path: str = "<text>"):
+        if isinstance(diagnostics, str):
+            diagnostics = [Diagnostic(path, 0, 0, diagnostics)]
+        elif isinstance(diagnostics, Diagnostic):
+            diagnostics = [diagnostics]
+        self.diagnostics: list[Diagnostic] = list(diagnostics)
+        first = self.diagnostics[0]
+        self.path: str = first.path
+        self.line: int = first.line
+        self.column: int = first.column
+        self.message: str = first.message
+        self.hint: str | None = first.hint
+        super().__init__(self.render())
+
+    def render(self) -> str:
+        text = "\n".join(d.render() for d in self.diagnostics)
+        if len(self.diagnostics) > 1:
+            text += f"\n{len(self.diagnostics)} errors"
+        return text
+
+
+class BgrSyntaxError(BgrError):
+    """The text is not a .bgr file: a token out of place, an unknown character, a bad literal."""
+
+
+class BgrCheckError(BgrError):
+    """The file parses but does not check: unknown names, wrong argument counts, duplicates."""
+
+
+def suggest(name: str, known: Iterable[str]) -> str | None:
+    """The closest known name to a misspelt one, as a hint, or None when nothing is close."""
+    known = sorted(set(known))
+    for candidate in known:  # a difference of case only is the most likely slip
+        if candidate.lower() == name.lower() and candidate != name:
+            return f"did you mean '{candidate}'?"
+    close = difflib.get_close_matches(name, known, n=1, cutoff=0.6)
+    return f"did you mean '{close[0]}'?" if close else None
+
+
+def source_line(source: str, line: int) -> str | None:
+    lines = source.splitlines()
+    return lines[line - 1] if 0 < line <= len(lines) else None

@@ -1,0 +1,360 @@
+"""Syntax tree -> canonical .bgr text, comments kept.  The only way the project writes .bgr.
+
+Layout rules (docs/language.md, "Formatting"):
+
+* one declaration or rule per line; blank lines between top-level items are kept (at most one);
+* a rule is one line when it fits in 100 columns; otherwise, or when a comment sits inside it,
+  its stochastic or conditional branches go one per line, and its split / comp / offset blocks
+  open with ``{`` and put one entry per line, each after a leading ``|``;
+* spacing is fixed: ``a + b``, ``f(a, b)``, ``{ 3: A | ~1: B }``, ``[ t(0, 0, 1) A ]``;
+* expressions get the parentheses their meaning needs and no more.
+
+Comments are anchored to output lines: a comment on its own line goes before the first line that
+comes after it in the source; a comment after code goes at the end of that code's line.  The
+result is idempotent and ``parse(format(x)) == parse(x)``.
+"""
+
+from __future__ import annotations
+
+import bisect
+import math
+from dataclasses import dataclass
+
+from . import nodes as n
+
+WIDTH = 100
+INDENT = "    "
+
+# Precedence levels, loosest first; they mirror the tree builder's binding powers.
+_LEVEL = {"or": 1, "and": 2, "==": 4, "!=": 4, "<": 4, "<=": 4, ">": 4, ">=": 4,
+          "+": 5, "-": 5, "*": 6, "/": 6, "%": 6, "**": 8}
+_UNARY_LEVEL = {"not": 3, "-": 7, "+": 7}
+_ATOM = 9
+
+
+# ---- expressions --------------------------------------------------------------------------------
+
+def format_number(value: float) -> str:
+    if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
+        raise ValueError(f"cannot write {value!r} as a .bgr number")
+    if float(value).is_integer() and abs(value) < 1e16:
+        return str(int(value))
+    return repr(float(value))
+
+
+def format_string(value: str) -> str:
+    escaped = value.replace("\\", "\\\\").replace('"', '\\"').replace("\n", "\\n").replace("\t", "\\t")
+    return f'"{escaped}"'
+
+
+def _level(e) -> int:
+    if isinstance(e, n.Binary):
+        return _LEVEL[e.op]
+    if isinstance(e, n.Unary):
+        return _UNARY_LEVEL[e.op]
+    if isinstance(e, n.Ternary):
+        return 0
+    if isinstance(e, n.Number) and (e.value < 0 or (e.value == 0 and math.copysign(1, e.value) < 0)):
+        return _UNARY_LEVEL["-"]  # -2 prints like a prefix minus
+    return _ATOM
+
+
+def format_expr(e) -> str:
+    """An expression with the fewest parentheses that keep its meaning."""
+    if isinstance(e, n.Number):
+        return format_number(e.value)
+    if isinstance(e, n.String):
+        return format_string(e.value)
+    if isinstance(e, n.Bool):
+        return "true" if e.value else "false"
+    if isinstance(e, n.Name):
+        return e.name
+    if isinstance(e, n.Call):
+        return f"{e.name}({', '.join(format_arg(a) for a in e.args)})"
+    if isinstance(e, n.Relative):
+        return "'" + format_expr(e.expr)
+    if isinstance(e, n.Unary):
+        inner = format_expr(e.operand)
+        # `not` takes everything down to comparisons; `-` and `+` take only `**`
+        if _level(e.operand) < (3 if e.op == "not" else 8):
+            inner = f"({inner})"
+        return f"not {inner}" if e.op == "not" else f"{e.op}{inner}"
+    if isinstance(e, n.Binary):
+        p = _LEVEL[e.op]
+        left, right = format_expr(e.left), format_expr(e.right)
+        ll, rl = _level(e.left), _level(e.right)
+        left_paren = ll <= p if (e.op == "**" or p == 4) else ll < p
+        if _is_signed(e.right):  # a prefix minus opens a term of its own: a * -b, a ** -b
+            right_paren = False
+        elif isinstance(e.right, n.Unary):  # `not`: only `and` and `or` can take it bare
+            right_paren = p > 2
+        else:
+            right_paren = rl < p if e.op == "**" else rl <= p
+        if left_paren:
+            left = f"({left})"
+        if right_paren:
+            right = f"({right})"
+        return f"{left} {e.op} {right}"
+    if isinstance(e, n.Ternary):
+        cond = format_expr(e.cond)
+        if _level(e.cond) == 0:
+            cond = f"({cond})"
+        return f"{cond} ? {format_expr(e.then)} : {format_expr(e.otherwise)}"
+    raise TypeError(f"not an expression: {e!r}")
+
+
+def _is_signed(e) -> bool:
+    """A prefix ``-``/``+`` term or a negative number: it binds only ``**`` to its right."""
+    return (isinstance(e, n.Unary) and e.op in ("-", "+")) or (isinstance(e, n.Number) and _level(e) == 7)
+
+
+def format_arg(a) -> str:
+    return format_expr(a)
+
+
+def _guarded(e) -> str:
+    """An expression in front of ':' (a split size, a case): a ternary there gets parentheses."""
+    text = format_expr(e)
+    return f"({text})" if isinstance(e, n.Ternary) else text
+
+
+# ---- layout -------------------------------------------------------------------------------------
+
+@dataclass
+class Line:
+    text: str
+    anchor: int  # the source line this output line starts from
+    indent: int
+    top: bool = False  # the first line of a top-level item, or a comment before one
+
+
+class _Writer:
+    def __init__(self) -> None:
+        self.lines: list[Line] = []
+        self.parts: list[str] = []
+        self.anchor, self.indent, self.top = 0, 0, False
+
+    def start(self, anchor: int, indent: int, top: bool = False) -> None:
+        self.flush()
+        self.anchor, self.indent, self.top = anchor, indent, top
+
+    def write(self, text: str) -> None:
+        self.parts.append(text)
+
+    def column(self) -> int:
+        return len(INDENT) * self.indent + sum(len(p) for p in self.parts)
+
+    def flush(self) -> None:
+        if self.parts:
+            self.lines.append(Line("".join(self.parts).rstrip(), self.anchor, self.indent, self.top))
+        self.parts = []
+
+
+class Formatter:
+    def __init__(self, module: n.Module, width: int = WIDTH) -> None:
+        self.module = module
+        self.width = width
+        self.comments = sorted(module.comments, key=lambda c: (c.line, c.column))
+        self.comment_keys = [(c.line, c.column) for c in self.comments]
+        self.source_lines = module.source.splitlines() if module.source else []
+
+    # ---- comments inside a span decide between one line and several -------------------
+    def has_comment_inside(self, pos: n.Pos) -> bool:
+        if not pos.line or not self.comments:
+            return False
+        i = bisect.bisect_left(self.comment_keys, (pos.line, 0))
+        return i < len(self.comment_keys) and self.comment_keys[i] < (pos.end_line, pos.end_column)
+
+    def can_inline(self, node) -> bool:
+        if self.has_comment_inside(node.pos):
+            return False
+        return all(self.can_inline(b) for b in _blocks_in(node))
+
+    # ---- items --------------------------------------------------------------------------
+    def format(self) -> str:
+        out = _Writer()
+        for item in self.module.items:
+            out.start(item.pos.line, 0, top=True)
+            if isinstance(item, n.Rule):
+                self.rule(item, out)
+            else:
+                out.write(self.declaration(item))
+        out.flush()
+        return self.render(self.place_comments(out.lines))
+
+    def declaration(self, item) -> str:
+        if isinstance(item, n.Version):
+            return f"version {format_number(item.number)}"
+        if isinstance(item, n.Import):
+            target = item.module if item.module is not None else format_string(item.path)
+            return f"import {target} as {item.alias}"
+        if isinstance(item, n.Attr):
+            return f"attr {item.name} = {format_expr(item.value)}"
+        if isinstance(item, n.Const):
+            return f"const {item.name} = {format_expr(item.value)}"
+        if isinstance(item, n.Func):
+            return f"func {item.name}({', '.join(item.params)}) = {format_expr(item.body)}"
+        if isinstance(item, n.Asset):
+            return f"asset {item.name} = {format_string(item.path)}"
+        if isinstance(item, n.TerminalDecl):
+            return f"terminal {', '.join(item.names)}"
+        if isinstance(item, n.Start):
+            return f"start {item.name}"
+        raise TypeError(f"not a top-level item: {item!r}")
+
+    def rule(self, rule: n.Rule, out: _Writer) -> None:
+        head = rule.name + (f"({', '.join(rule.params)})" if rule.params else "") + " -->"
+        body = rule.body
+        if isinstance(body, n.Sequence):
+            out.write(head + " ")
+            self.steps(body.steps, out)
+            return
+        alts = body.choices if isinstance(body, n.Stochastic) else body.cases
+        heads = [self.alt_head(a) for a in alts]
+        inline = head + " " + " | ".join(h + self.inline_steps(a.body.steps) for h, a in zip(heads, alts))
+        if all(self.can_inline(a.body) for a in alts) and not self.has_comment_inside(body.pos) \
+                and len(inline) <= self.width:
+            out.write(inline)
+            return
+        out.write(head)
+        for i, (h, alt) in enumerate(zip(heads, alts)):
+            out.start(alt.pos.line or rule.pos.line, 1)
+            out.write(("| " if i else "") + h)
+            self.steps(alt.body.steps, out)
+
+    def alt_head(self, alt) -> str:
+        if isinstance(alt, n.Choice):
+            if alt.prob is None:
+                return "else: "
+            if isinstance(alt.prob, n.Number) and alt.prob.value >= 0:
+                return f"{format_number(alt.prob.value)}%: "
+            return f"({format_expr(alt.prob)})%: "
+        return "else: " if alt.cond is None else f"case {_guarded(alt.cond)}: "
+
+    # ---- steps and blocks ------------------------------------------------------------------
+    def inline_steps(self, steps) -> str:
+        w = _Writer()
+        self.steps(steps, w, force_inline=True)
+        w.flush()
+        return w.lines[0].text if w.lines else ""
+
+    def steps(self, steps, out: _Writer, force_inline: bool = False) -> None:
+        for i, step in enumerate(steps):
+            if i:
+                out.write(" ")
+            if isinstance(step, n.Nil):
+                out.write("NIL")
+            elif isinstance(step, n.Successor):
+                out.write(step.name + (f"({', '.join(format_arg(a) for a in step.args)})" if step.args else ""))
+            elif isinstance(step, n.Push):
+                out.write("[ " if step.steps else "[")
+                self.steps(step.steps, out, force_inline)
+                out.write(" ]")
+            elif isinstance(step, n.Operation):
+                out.write(f"{step.name}({', '.join(format_arg(a) for a in step.args)})")
+                if step.block is not None:
+                    out.write(" ")
+                    self.block(step.block.entries, step.block.repeat, step.block.pos, out, force_inline)
+            else:
+                raise TypeError(f"not a step: {step!r}")
+
+    def inline_block(self, entries, star: bool) -> str:
+        return "{ " + " | ".join(self.inline_entry(e) for e in entries) + " }" + ("*" if star else "")
+
+    def inline_entry(self, entry) -> str:
+        if isinstance(entry, n.Group):
+            return self.inline_block(entry.entries, True)
+        return self.key(entry) + self.inline_steps(entry.body.steps)
+
+    def key(self, entry: n.Entry) -> str:
+        prefix = {"abs": "", "rel": "'", "float": "~"}[entry.kind]
+        return f"{prefix}{_guarded(entry.key)}: "
+
+    def block(self, entries, star: bool, pos: n.Pos, out: _Writer, force_inline: bool) -> None:
+        inline = self.inline_block(entries, star)
+        fits = out.column() + len(inline) <= self.width
+        if force_inline or (fits and not self.has_comment_inside(pos)
+                            and all(self.can_inline(e) for e in entries)):
+            out.write(inline)
+            return
+        indent = out.indent
+        out.write("{")
+        for i, entry in enumerate(entries):
+            out.start(entry.pos.line or out.anchor, indent + 1)
+            out.write("| " if i else "")
+            if isinstance(entry, n.Group):
+                self.block(entry.entries, True, entry.pos, out, False)
+            else:
+                out.write(self.key(entry))
+                self.steps(entry.body.steps, out)
+        out.start(pos.end_line or out.anchor, indent)
+        out.write("}" + ("*" if star else ""))
+
+    # ---- comments and blank lines ----------------------------------------------------------
+    def place_comments(self, lines: list[Line]) -> list[Line]:
+        leading: dict[int, list[Line]] = {}
+        trailing: dict[int, list[str]] = {}
+        tail: list[Line] = []
+        anchors = [ln.anchor for ln in lines]
+        for c in self.comments:
+            if c.own_line:
+                i = bisect.bisect_right(anchors, c.line)
+                if i < len(lines):
+                    target = lines[i]
+                    leading.setdefault(i, []).append(Line(c.text, c.line, target.indent, target.top))
+                else:
+                    tail.append(Line(c.text, c.line, 0, True))
+            else:
+                i = bisect.bisect_right(anchors, c.line) - 1
+                if i >= 0:
+                    trailing.setdefault(i, []).append(c.text)
+                else:  # cannot happen for parsed text; keep the comment all the same
+                    leading.setdefault(0, []).append(Line(c.text, c.line, 0, True))
+        placed: list[Line] = []
+        for i, line in enumerate(lines):
+            placed += leading.get(i, [])
+            if i in trailing:
+                line = Line(line.text + "  " + "  ".join(trailing[i]), line.anchor, line.indent, line.top)
+            placed.append(line)
+        return placed + tail
+
+    def render(self, lines: list[Line]) -> str:
+        text = []
+        for line in lines:
+            if line.top and text and text[-1] != "" and self.blank_before(line.anchor):
+                text.append("")
+            text.append(INDENT * line.indent + line.text)
+        return "\n".join(text) + "\n" if text else ""
+
+    def blank_before(self, line: int) -> bool:
+        return 1 < line <= len(self.source_lines) + 1 and not self.source_lines[line - 2].strip()
+
+
+def _blocks_in(node):
+    """The blocks and groups directly or indirectly inside a node (not the node itself)."""
+    if isinstance(node, (n.Block, n.Group)):
+        for e in node.entries:
+            if isinstance(e, n.Group):
+                yield e
+            else:
+                yield from _blocks_in(e.body)
+    elif isinstance(node, n.Entry):
+        yield from _blocks_in(node.body)
+    elif isinstance(node, (n.Sequence, n.Push)):
+        for step in node.steps:
+            if isinstance(step, n.Operation) and step.block is not None:
+                yield step.block
+            elif isinstance(step, n.Push):
+                yield from _blocks_in(step)
+
+
+def format_module(module: n.Module, width: int = WIDTH) -> str:
+    """Canonical text of a syntax tree (parsed, or built by an inverse module)."""
+    return Formatter(module, width).format()
+
+
+def format_source(text: str, path: str = "<text>") -> str:
+    """Canonical text of .bgr source; raises BgrSyntaxError on text that does not parse."""
+    from .parser import parse
+
+    return format_module(parse(text, path))

@@ -1,0 +1,177 @@
+"""Reading files and resolving imports: the public ``load`` behind :func:`bgr.load`.
+
+A file is parsed, its imports are loaded (relative paths from the importing file's folder,
+``stdlib.NAME`` from the bundled standard library), then it is checked.  Every error of every
+file involved is collected and raised together as one :class:`BgrError`.
+"""
+
+from __future__ import annotations
+
+import gc
+import os
+from pathlib import Path
+
+from . import nodes as n
+from .checker import Checker, Grammar
+from .errors import BgrCheckError, BgrError, BgrSyntaxError, Diagnostic, source_line, suggest
+from .parser import parse
+
+STDLIB_DIR = Path(__file__).resolve().parent.parent / "stdlib"
+
+
+def _stdlib_dir() -> Path:
+    """The bundled stdlib: ``bgr/stdlib`` when installed, ``stdlib/`` in a source checkout."""
+    try:
+        import bgr.stdlib
+
+        return Path(bgr.stdlib.__file__).resolve().parent
+    except ImportError:  # pragma: no cover - only when the grammar package is used on its own
+        return STDLIB_DIR
+
+
+def stdlib_modules() -> list[str]:
+    return sorted(p.stem for p in _stdlib_dir().glob("*.bgr"))
+
+
+def read_source(path: str | os.PathLike) -> str:
+    """Read a .bgr file as UTF-8, with errors a user can act on."""
+    shown = str(path)
+    try:
+        data = Path(path).read_bytes()
+    except FileNotFoundError:
+        raise BgrError(Diagnostic(shown, 0, 0, "no such file", "check the path")) from None
+    except IsADirectoryError:
+        raise BgrError(Diagnostic(shown, 0, 0, "is a folder, not a .bgr file")) from None
+    except OSError as e:
+        raise BgrError(Diagnostic(shown, 0, 0, f"cannot read the file: {e.strerror or e}")) from None
+    return decode(data, shown)
+
+
+def decode(data: bytes, path: str) -> str:
+    try:
+        text = data.decode("utf-8")
+    except UnicodeDecodeError as e:
+        line = data.count(b"\n", 0, e.start) + 1
+        column = e.start - (data.rfind(b"\n", 0, e.start) + 1) + 1
+        raise BgrSyntaxError(Diagnostic(path, line, column, f"the file is not UTF-8 text (byte 0x{data[e.start]:02x})",
+                                        "save it as UTF-8")) from None
+    return text[1:] if text.startswith("\ufeff") else text
+
+
+class Loader:
+    """Loads a root file and everything it imports, each file once."""
+
+    def __init__(self) -> None:
+        self.done: dict[str, Grammar] = {}
+        self.failed: set[str] = set()
+        self.diagnostics: list[Diagnostic] = []
+
+    def load_text(self, text: str, path: str, key: str | None, stack: tuple[str, ...]) -> Grammar | None:
+        try:
+            module = parse(text, path)
+        except BgrError as e:
+            self.diagnostics += e.diagnostics
+            return None
+        grammar = Grammar(path, module)
+        folder = Path(key).parent if key else Path.cwd()
+        broken: dict[str, bool] = {}
+        for item in module.items:
+            if isinstance(item, n.Import):
+                imported = self.load_import(item, folder, module, stack)
+                if imported is not None:
+                    grammar.imports[item.alias] = imported
+                broken[item.alias] = imported is None
+        self.diagnostics += Checker(grammar, broken).check()
+        return grammar
+
+    def load_import(self, item: n.Import, folder: Path, module: n.Module, stack: tuple[str, ...]) -> Grammar | None:
+        def fail(message: str, hint: str | None = None) -> None:
+            self.diagnostics.append(Diagnostic(module.path, item.pos.line, item.pos.column, message, hint,
+                                               source_line(module.source, item.pos.line)))
+
+        if item.module is not None:
+            parts = item.module.split(".")
+            if parts[0] != "stdlib" or len(parts) != 2:
+                fail(f"cannot import '{item.module}' by name: only stdlib.NAME modules are",
+                     f'import other files by path: import "{"/".join(parts)}.bgr" as {item.alias}')
+                return None
+            target = _stdlib_dir() / f"{parts[1]}.bgr"
+            if not target.is_file():
+                hint = suggest(parts[1], stdlib_modules())
+                fail(f"there is no stdlib module '{parts[1]}'",
+                     hint or "known: " + ", ".join(stdlib_modules()))
+                return None
+            shown = f"stdlib/{parts[1]}.bgr"
+        else:
+            target = folder / item.path
+            shown = os.path.relpath(target) if not Path(item.path).is_absolute() else item.path
+            if not target.is_file():
+                fail(f"cannot find the imported file '{item.path}'", f"looked for {target}")
+                return None
+        key = str(target.resolve())
+        if key in stack:
+            chain = " -> ".join(Path(k).name for k in stack[stack.index(key):]) + f" -> {Path(key).name}"
+            fail(f"import cycle: {chain}", "a module cannot import itself, directly or through others")
+            return None
+        if key in self.done:
+            return self.done[key]
+        if key in self.failed:
+            return None
+        try:
+            text = read_source(target)
+        except BgrError as e:
+            self.diagnostics += e.diagnostics
+            self.failed.add(key)
+            return None
+        grammar = self.load_text(text, shown, key, stack + (key,))
+        if grammar is None:
+            self.failed.add(key)
+        else:
+            self.done[key] = grammar
+        return grammar
+
+
+def load(source: str | bytes | os.PathLike, path: str | None = None) -> Grammar:
+    """Parse, resolve and check a grammar; return it, or raise :class:`BgrError` with every problem.
+
+    ``source`` is a path (a :class:`os.PathLike`, or a one-line string naming an existing file or
+    ending in ``.bgr``), or the text of a grammar (a string with a newline or ``-->`` in it, or
+    bytes).  ``path`` names text in messages and is the base for its relative imports.
+    """
+    key = None
+    if isinstance(source, bytes):
+        text = decode(source, path or "<text>")
+    elif isinstance(source, os.PathLike) or _looks_like_path(source):
+        key = str(Path(source).resolve())
+        path = path or str(source)
+        text = read_source(source)
+    elif isinstance(source, str):
+        text = source
+    else:
+        raise TypeError(f"bgr.load takes a path or the text of a grammar, not {type(source).__name__}")
+    if path is not None and key is None and Path(path).suffix == ".bgr":
+        key = str(Path(path).resolve())
+    loader = Loader()
+    was_enabled = gc.isenabled()
+    gc.disable()  # parsing makes many small objects and no cycles; collection only slows it
+    try:
+        grammar = loader.load_text(text, path or "<text>", key, (key,) if key else ())
+    except RecursionError:
+        raise BgrSyntaxError(Diagnostic(path or "<text>", 0, 0,
+                                        "the grammar nests expressions or blocks too deeply to process",
+                                        "split deep nesting into separate rules")) from None
+    finally:
+        if was_enabled:
+            gc.enable()
+    if loader.diagnostics:
+        unique = {(d.path, d.line, d.column, d.message): d for d in loader.diagnostics}
+        ordered = sorted(unique.values(), key=lambda d: (d.path != (path or "<text>"), d.path, d.line, d.column))
+        raise (BgrSyntaxError if grammar is None else BgrCheckError)(ordered)
+    assert grammar is not None
+    return grammar
+
+
+def _looks_like_path(source: object) -> bool:
+    if not isinstance(source, str) or "\n" in source or "-->" in source:
+        return False
+    return source.endswith(".bgr") or os.path.isfile(source)

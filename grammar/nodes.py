@@ -1,0 +1,306 @@
+"""The syntax tree of a .bgr file: small dataclasses that carry their source positions.
+
+Positions never take part in equality (``field(compare=False)``), so two trees that differ only in
+layout compare equal: that is how the formatter's round trip ``parse(fmt(x)) == parse(x)`` is
+stated and tested.  The parser builds these trees from text; the inverse modules build them
+directly and print them with :mod:`bgr.grammar.formatter`.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Union
+
+
+@dataclass(frozen=True)
+class Pos:
+    """A span of source text: 1-based line and column of its first and last character."""
+
+    line: int = 0
+    column: int = 0
+    end_line: int = 0
+    end_column: int = 0
+
+
+NOWHERE = Pos()
+
+
+def _pos():
+    return field(default=NOWHERE, compare=False, repr=False, kw_only=True)
+
+
+# ---- expressions -----------------------------------------------------------------------------
+
+
+@dataclass
+class Number:
+    value: float
+    pos: Pos = _pos()
+
+
+@dataclass
+class String:
+    value: str
+    pos: Pos = _pos()
+
+
+@dataclass
+class Bool:
+    value: bool
+    pos: Pos = _pos()
+
+
+@dataclass
+class Name:
+    """A name, possibly dotted: ``height``, ``scope.sx``, ``fac.floor_h``."""
+
+    name: str
+    pos: Pos = _pos()
+
+
+@dataclass
+class Call:
+    """A function call inside an expression: a built-in (``rand``) or a ``func``."""
+
+    name: str
+    args: list[Expr]
+    pos: Pos = _pos()
+
+
+@dataclass
+class Unary:
+    op: str  # '-', '+', 'not'
+    operand: Expr
+    pos: Pos = _pos()
+
+
+@dataclass
+class Binary:
+    op: str  # + - * / % ** == != < <= > >= and or
+    left: Expr
+    right: Expr
+    pos: Pos = _pos()
+
+
+@dataclass
+class Ternary:
+    cond: Expr
+    then: Expr
+    otherwise: Expr
+    pos: Pos = _pos()
+
+
+@dataclass
+class Relative:
+    """``'expr`` as an operation argument: a fraction of the current scope size (``s('0.5, 0, 0)``)."""
+
+    expr: Expr
+    pos: Pos = _pos()
+
+
+Expr = Union[Number, String, Bool, Name, Call, Unary, Binary, Ternary]
+Arg = Union[Expr, Relative]
+
+
+# ---- rule bodies -----------------------------------------------------------------------------
+
+
+@dataclass
+class Operation:
+    """A shape operation from the registry: ``extrude(3)``, ``split(x) { ... }``."""
+
+    name: str
+    args: list[Arg]
+    block: Block | None = None
+    pos: Pos = _pos()
+
+
+@dataclass
+class Successor:
+    """A rule application: ``Facade``, ``Floor(i)``, ``fac.Tripartite(3.2)``."""
+
+    name: str
+    args: list[Arg] = field(default_factory=list)
+    pos: Pos = _pos()
+
+
+@dataclass
+class Push:
+    """``[ ... ]``: the steps inside work on a copy of the shape state."""
+
+    steps: list[Step]
+    pos: Pos = _pos()
+
+
+@dataclass
+class Nil:
+    pos: Pos = _pos()
+
+
+Step = Union[Operation, Successor, Push, Nil]
+
+
+@dataclass
+class Sequence:
+    steps: list[Step]
+    pos: Pos = _pos()
+
+
+@dataclass
+class Entry:
+    """One piece of a block: ``3: A``, ``'0.5: A``, ``~2: A``, ``front: A``, ``inside: A``.
+
+    ``kind`` is ``abs``, ``rel`` or ``float`` (the prefix the size was written with).  For
+    ``comp`` and ``offset`` blocks the key is a selector, held as an expression (``Name('front')``,
+    ``Call('face', [Number(2)])``) with kind ``abs``.
+    """
+
+    kind: str
+    key: Expr
+    body: Sequence
+    pos: Pos = _pos()
+
+
+@dataclass
+class Group:
+    """A repeat group ``{ ... }*`` inside a block: a Kleene star."""
+
+    entries: list[Entry | Group]
+    pos: Pos = _pos()
+
+
+@dataclass
+class Block:
+    """The ``{ ... }`` of split, comp and offset.  ``repeat`` is the ``split(x) { ... }*`` shorthand,
+    which means the whole block is one repeat group."""
+
+    entries: list[Entry | Group]
+    repeat: bool = False
+    pos: Pos = _pos()
+
+
+@dataclass
+class Choice:
+    """One branch of a stochastic body; ``prob`` is ``None`` for ``else``."""
+
+    prob: Expr | None
+    body: Sequence
+    pos: Pos = _pos()
+
+
+@dataclass
+class Stochastic:
+    choices: list[Choice]
+    pos: Pos = _pos()
+
+
+@dataclass
+class Case:
+    """One branch of a conditional body; ``cond`` is ``None`` for ``else``."""
+
+    cond: Expr | None
+    body: Sequence
+    pos: Pos = _pos()
+
+
+@dataclass
+class Conditional:
+    cases: list[Case]
+    pos: Pos = _pos()
+
+
+Body = Union[Sequence, Stochastic, Conditional]
+
+
+# ---- top-level items -------------------------------------------------------------------------
+
+
+@dataclass
+class Rule:
+    name: str
+    params: list[str]
+    body: Body
+    pos: Pos = _pos()
+
+
+@dataclass
+class Version:
+    number: float
+    pos: Pos = _pos()
+
+
+@dataclass
+class Import:
+    """``import "lib/w.bgr" as w`` (``path`` set) or ``import stdlib.facade as fac`` (``module``)."""
+
+    alias: str
+    path: str | None = None
+    module: str | None = None
+    pos: Pos = _pos()
+
+
+@dataclass
+class Attr:
+    name: str
+    value: Expr
+    pos: Pos = _pos()
+
+
+@dataclass
+class Const:
+    name: str
+    value: Expr
+    pos: Pos = _pos()
+
+
+@dataclass
+class Func:
+    name: str
+    params: list[str]
+    body: Expr
+    pos: Pos = _pos()
+
+
+@dataclass
+class Asset:
+    name: str
+    path: str
+    pos: Pos = _pos()
+
+
+@dataclass
+class TerminalDecl:
+    names: list[str]
+    pos: Pos = _pos()
+
+
+@dataclass
+class Start:
+    name: str
+    pos: Pos = _pos()
+
+
+Item = Union[Version, Import, Attr, Const, Func, Asset, TerminalDecl, Start, Rule]
+
+
+@dataclass
+class Comment:
+    """A source comment, kept so that the formatter can put it back."""
+
+    text: str
+    line: int
+    column: int
+    own_line: bool  # nothing but whitespace before it on its line
+
+
+@dataclass
+class Module:
+    """A whole file.  ``comments`` and ``source`` are layout, not meaning: they do not compare."""
+
+    items: list[Item]
+    path: str = field(default="<text>", compare=False)
+    comments: list[Comment] = field(default_factory=list, compare=False, repr=False)
+    source: str = field(default="", compare=False, repr=False)
+
+    def rules(self) -> list[Rule]:
+        return [item for item in self.items if isinstance(item, Rule)]

@@ -1,0 +1,453 @@
+"""Text -> syntax tree: Lark's LALR parser with the contextual lexer, and a tree builder.
+
+The tree builder runs inside the parser (Lark's ``transformer=`` option), so no intermediate
+parse tree is built.  Lark's exceptions are translated into :class:`BgrSyntaxError` messages in
+the language's own words ("expected '-->'"), never in terminal names.
+"""
+
+from __future__ import annotations
+
+import math
+import threading
+from pathlib import Path
+
+from lark import Lark, Token, Transformer
+from lark.exceptions import UnexpectedCharacters, UnexpectedEOF, UnexpectedInput, UnexpectedToken
+
+from . import nodes as n
+from .errors import BgrSyntaxError, Diagnostic, source_line, suggest
+from .registry import KEYWORDS, OPERATIONS
+
+GRAMMAR_FILE = Path(__file__).with_name("bgr.lark")
+
+
+def _first(x):
+    """The first source position inside a child (a token, a node, or a list of them)."""
+    if isinstance(x, Token):
+        return (x.line, x.column)
+    pos = getattr(x, "pos", None)
+    if pos is not None and pos.line:
+        return (pos.line, pos.column)
+    if isinstance(x, (list, tuple)):
+        for item in x:
+            found = _first(item)
+            if found:
+                return found
+    return None
+
+
+def _last(x):
+    if isinstance(x, Token):
+        return (x.end_line, x.end_column)
+    pos = getattr(x, "pos", None)
+    if pos is not None and pos.line:
+        return (pos.end_line, pos.end_column)
+    if isinstance(x, (list, tuple)):
+        for item in reversed(x):
+            found = _last(item)
+            if found:
+                return found
+    return None
+
+
+def _span(*children) -> n.Pos:
+    """The span of a node from its children: Lark cannot hand positions to an inline builder."""
+    start, end = _first(children), _last(children)
+    if start is None:
+        return n.NOWHERE
+    return n.Pos(start[0], start[1], *(end or start))
+
+
+def _tok_pos(tok: Token) -> n.Pos:
+    return n.Pos(tok.line, tok.column, tok.end_line or tok.line, tok.end_column or tok.column)
+
+
+class _Problem(Exception):
+    """Raised by the tree builder for a construct the grammar accepts but the language does not."""
+
+    def __init__(self, pos: n.Pos, message: str, hint: str | None = None, length: int = 1):
+        super().__init__(message)
+        self.pos, self.message, self.hint, self.length = pos, message, hint, length
+
+
+def _unescape(tok: Token) -> str:
+    body = tok[1:-1]
+    out, i = [], 0
+    escapes = {'"': '"', "\\": "\\", "n": "\n", "t": "\t"}
+    while i < len(body):
+        c = body[i]
+        if c == "\\":
+            nxt = body[i + 1]
+            if nxt not in escapes:
+                pos = n.Pos(tok.line, tok.column + i + 1, tok.line, tok.column + i + 2)
+                raise _Problem(pos, f"unknown escape '\\{nxt}' in a string",
+                               'strings know \\" \\\\ \\n and \\t; write \\\\ for a backslash', 2)
+            out.append(escapes[nxt])
+            i += 2
+        else:
+            out.append(c)
+            i += 1
+    return "".join(out)
+
+
+class _TreeBuilder(Transformer):
+    """Parse-tree callbacks -> :mod:`nodes` dataclasses, run by the parser as it reduces."""
+
+    # ---- declarations ---------------------------------------------------------------------
+    def start(self, items):
+        return list(items)
+
+    def version_decl(self, c):
+        return n.Version(_number(c[0]), pos=_span(c))
+
+    def import_file(self, c):
+        return n.Import(str(c[1]), path=_unescape(c[0]), pos=_span(c))
+
+    def import_module(self, c):
+        return n.Import(str(c[1]), module=str(c[0]), pos=_span(c))
+
+    def attr_decl(self, c):
+        return n.Attr(str(c[0]), c[1], pos=_span(c))
+
+    def const_decl(self, c):
+        return n.Const(str(c[0]), c[1], pos=_span(c))
+
+    def func_decl(self, c):
+        return n.Func(str(c[0]), c[1] or [], c[2], pos=_span(c))
+
+    def asset_decl(self, c):
+        return n.Asset(str(c[0]), _unescape(c[1]), pos=_span(c))
+
+    def terminal_decl(self, c):
+        return n.TerminalDecl([str(t) for t in c[0]], pos=_span(c))
+
+    def start_decl(self, c):
+        return n.Start(str(c[0]), pos=_span(c))
+
+    def names(self, c):
+        return list(c)
+
+    def dotted(self, c):
+        return Token("NAME", ".".join(c), line=c[0].line, column=c[0].column,
+                     end_line=c[-1].end_line, end_column=c[-1].end_column)
+
+    # ---- rules ----------------------------------------------------------------------------
+    def rule(self, c):
+        name_tok, params, _arrow, body = c
+        if str(name_tok) in KEYWORDS:
+            raise _Problem(_tok_pos(name_tok), f"'{name_tok}' is a keyword and cannot name a rule",
+                           "choose another name, e.g. a capitalised one", len(name_tok))
+        return n.Rule(str(name_tok), [str(p) for p in params], body, pos=_span(c))
+
+    def rule_params(self, c):
+        return c[0] if c and c[0] else []
+
+    def alternatives(self, alts):
+        kinds = [kind for kind, *_ in alts]
+        for i, (kind, _, _, pos) in enumerate(alts):
+            if kind == "else" and i != len(alts) - 1:
+                raise _Problem(pos, "'else' must be the last alternative", length=4)
+        if set(kinds) == {"else"}:
+            raise _Problem(alts[0][3], "a body cannot be only an 'else' branch",
+                           "write the sequence without 'else:'", 4)
+        if "choice" in kinds and "case" in kinds:
+            second = alts[kinds.index("case" if kinds[0] == "choice" else "choice")]
+            raise _Problem(second[3], "a body mixes percentages and 'case' conditions",
+                           "use either '60%: A | else: B' or 'case cond: A | else: B'")
+        if "choice" in kinds:
+            return n.Stochastic([n.Choice(test, body, pos=pos) for _, test, body, pos in alts],
+                                pos=_span(alts[0][3], alts[-1][3]))
+        return n.Conditional([n.Case(test, body, pos=pos) for _, test, body, pos in alts],
+                             pos=_span(alts[0][3], alts[-1][3]))
+
+    def choice(self, c):
+        return ("choice", c[0], c[1], _span(c))
+
+    def case(self, c):
+        return ("case", c[1], c[2], _span(c))
+
+    def else_alt(self, c):
+        return ("else", None, c[1], _span(c))
+
+    def sequence(self, c):
+        return n.Sequence(list(c), pos=_span(c))
+
+    def nil(self, c):
+        return n.Nil(pos=_span(c))
+
+    def push(self, c):
+        return n.Push(list(c[1:-1]), pos=_span(c))
+
+    def successor(self, c):
+        return n.Successor(str(c[0]), [], pos=_span(c))
+
+    def call(self, c):
+        name, args, block = str(c[0]), c[1] or [], c[2]
+        if name in OPERATIONS:
+            return n.Operation(name, args, block, pos=_span(c))
+        if block is not None:
+            hint = suggest(name, [op for op, spec in OPERATIONS.items() if spec.block])
+            raise _Problem(_tok_pos(c[0]), f"unknown operation '{name}' with a {{ }} block",
+                           hint or "only split, comp and offset take a { } block", len(name))
+        return n.Successor(name, args, pos=_span(c))
+
+    def block(self, c):
+        return n.Block(c[0], repeat=c[2] is not None, pos=_span(c))
+
+    def entries(self, c):
+        return list(c)
+
+    def keyed(self, c):
+        kind, key = c[0]
+        return n.Entry(kind, key, c[1], pos=_span(key, c[1]))
+
+    def group(self, c):
+        return n.Group(c[0], pos=_span(c))
+
+    def key_abs(self, c):
+        return ("abs", c[0])
+
+    def key_rel(self, c):
+        return ("rel", c[0])
+
+    def key_float(self, c):
+        return ("float", c[0])
+
+    def args(self, c):
+        return list(c)
+
+    def rel_arg(self, c):
+        return n.Relative(c[0], pos=_span(c))
+
+    # ---- expressions ----------------------------------------------------------------------
+    def number(self, c):
+        return n.Number(_number(c[0]), pos=_tok_pos(c[0]))
+
+    def string(self, c):
+        return n.String(_unescape(c[0]), pos=_tok_pos(c[0]))
+
+    def true(self, c):
+        return n.Bool(True, pos=_tok_pos(c[0]))
+
+    def false(self, c):
+        return n.Bool(False, pos=_tok_pos(c[0]))
+
+    def name(self, c):
+        return n.Name(str(c[0]), pos=_tok_pos(c[0]))
+
+    def fcall(self, c):
+        return n.Call(str(c[0]), c[1] or [], pos=_span(c))
+
+    def ternary(self, c):
+        return n.Ternary(c[0], c[1], c[2], pos=_span(c))
+
+    def term(self, c):
+        return c  # prefix operator tokens, then the operand; ordered by chain()
+
+    def chain(self, c):
+        stream = []
+        for i, part in enumerate(c):
+            if i % 2:
+                stream.append(part)  # a binary operator token
+            else:
+                stream.extend(part)
+        if len(stream) == 1:
+            return stream[0]
+        return _Pratt(stream).parse()
+
+
+# Binding powers: (left, right).  Left-associative operators bind tighter on the right.
+_INFIX = {"or": (1, 2), "and": (3, 4),
+          "==": (7, 8), "!=": (7, 8), "<": (7, 8), "<=": (7, 8), ">": (7, 8), ">=": (7, 8),
+          "+": (9, 10), "-": (9, 10), "*": (11, 12), "/": (11, 12), "%": (11, 12),
+          "**": (15, 15)}
+_PREFIX = {"not": 5, "-": 13, "+": 13}  # right binding power of each prefix operator
+_COMPARISONS = {"==", "!=", "<", "<=", ">", ">="}
+
+
+class _Pratt:
+    """Orders a flat operator chain by precedence, as Python does: ``or`` < ``and`` < ``not`` <
+    comparisons < ``+ -`` < ``* / %`` < unary ``- +`` < ``**`` (right-associative)."""
+
+    def __init__(self, stream: list) -> None:
+        self.stream, self.i = stream, 0
+
+    def parse(self, min_bp: int = 0):
+        tok = self.stream[self.i]
+        self.i += 1
+        if isinstance(tok, Token):  # a prefix operator
+            operand = self.parse(_PREFIX[str(tok)])
+            if str(tok) == "-" and isinstance(operand, n.Number):  # -0.25 is a number literal
+                left = n.Number(-operand.value, pos=_span(tok, operand))
+            else:
+                left = n.Unary(str(tok), operand, pos=_span(tok, operand))
+        else:
+            left = tok
+        while self.i < len(self.stream):
+            op = self.stream[self.i]
+            lbp, rbp = _INFIX[str(op)]
+            if lbp < min_bp:
+                break
+            self.i += 1
+            right = self.parse(rbp)
+            if str(op) in _COMPARISONS and self.i < len(self.stream) and str(self.stream[self.i]) in _COMPARISONS:
+                nxt = self.stream[self.i]
+                raise _Problem(_tok_pos(nxt), f"comparisons cannot be chained: '{op}' then '{nxt}'",
+                               "write 'a < b and b < c'", len(nxt))
+            left = n.Binary(str(op), left, right, pos=_span(left, right))
+        return left
+
+
+def _number(tok: Token) -> float:
+    value = float(tok)
+    if math.isinf(value):
+        raise _Problem(_tok_pos(tok), f"number {tok} is too large", length=len(tok))
+    return value
+
+
+class _Comments:
+    """Collects COMMENT tokens, which the lexer hands over instead of dropping them."""
+
+    def __init__(self) -> None:
+        self.tokens: list[Token] = []
+
+    def __call__(self, tok: Token) -> Token:
+        self.tokens.append(tok)
+        return tok
+
+
+_lock = threading.Lock()
+_comments = _Comments()
+_parser: Lark | None = None
+
+
+def _lark() -> Lark:
+    global _parser
+    if _parser is None:
+        _parser = Lark(GRAMMAR_FILE.read_text(encoding="utf-8"), parser="lalr", lexer="contextual",
+                       propagate_positions=True, maybe_placeholders=True,
+                       transformer=_TreeBuilder(), lexer_callbacks={"COMMENT": _comments})
+    return _parser
+
+
+def parse(text: str, path: str = "<text>") -> n.Module:
+    """Parse .bgr source text into a :class:`nodes.Module`; raise :class:`BgrSyntaxError`."""
+    if "\x00" in text:
+        line = text.count("\n", 0, text.index("\x00")) + 1
+        col = text.index("\x00") - (text.rfind("\n", 0, text.index("\x00")) + 1) + 1
+        raise BgrSyntaxError(Diagnostic(path, line, col, "the file contains a NUL character",
+                                        "is this a binary file?", source_line(text, line)))
+    with _lock:
+        _comments.tokens = []
+        try:
+            items = _lark().parse(text)
+        except _Problem as p:
+            raise BgrSyntaxError(Diagnostic(path, p.pos.line, p.pos.column, p.message, p.hint,
+                                            source_line(text, p.pos.line), p.length)) from None
+        except UnexpectedInput as e:
+            raise _translate(e, text, path) from None
+        tokens = _comments.tokens
+        _comments.tokens = []
+    comments = []
+    lines = text.splitlines()
+    for tok in tokens:
+        before = lines[tok.line - 1][: tok.column - 1] if tok.line <= len(lines) else ""
+        comments.append(n.Comment(str(tok).rstrip(), tok.line, tok.column, not before.strip()))
+    return n.Module(items, path=path, comments=comments, source=text)
+
+
+# ---- error translation --------------------------------------------------------------------------
+
+_TERMINAL_WORDS = {
+    "NAME": "a name", "RULE_NAME": "a rule ('Name --> ...')", "NUMBER": "a number",
+    "STRING": 'a string ("...")', "ARROW": "'-->'", "STAR": "'*'", "COMPARE": "a comparison",
+    "BINOP": "an operator", "PREFIX": "'-'", "AND": "'and'", "OR": "'or'", "NOT": "'not'",
+    "CASE": "'case'", "ELSE": "'else'", "NIL": "NIL", "TRUE": "'true'", "FALSE": "'false'",
+    "RBRACE": "'}'", "LSQB": "'['", "RSQB": "']'", "$END": "the end of the file",
+}
+_EXPRESSION_START = {"NUMBER", "STRING", "NAME", "LPAR", "PREFIX", "TRUE", "FALSE", "NOT"}
+_STEP_START = {"NAME", "LSQB", "NIL"}
+_DECLARATIONS = {"VERSION", "IMPORT", "ATTR", "CONST", "FUNC", "ASSET", "TERMINAL", "START", "RULE_NAME"}
+
+
+def _describe_expected(expected: set[str]) -> list[str]:
+    expected = set(expected)
+    words = []
+    if _DECLARATIONS <= expected:
+        words.append("a declaration or a rule")
+        expected -= _DECLARATIONS
+    if _EXPRESSION_START <= expected:
+        words.append("an expression")
+        expected -= _EXPRESSION_START | {"QUOTE"}
+    if _STEP_START <= expected:
+        words.append("an operation or a successor")
+        expected -= _STEP_START
+    parser = _lark()
+    for name in sorted(expected):
+        if name in _TERMINAL_WORDS:
+            words.append(_TERMINAL_WORDS[name])
+            continue
+        try:
+            pattern = parser.get_terminal(name).pattern
+        except KeyError:
+            continue
+        words.append(f"'{pattern.value}'" if pattern.type == "str" else name.lower())
+    return sorted(set(words), key=lambda w: (w.startswith("'"), w))
+
+
+def _describe_token(tok: Token) -> str:
+    if tok.type == "$END":
+        return "end of file"
+    if tok.type in ("NAME", "RULE_NAME"):
+        return f"name '{tok}'"
+    if tok.type == "NUMBER":
+        return f"number {tok}"
+    if tok.type == "STRING":
+        return f"string {tok}"
+    return f"'{tok}'"
+
+
+def _hint(tok: Token | None, expected: set[str]) -> str | None:
+    if tok is None:
+        return None
+    if tok.type in ("NAME", "RULE_NAME") and "RULE_NAME" in expected:
+        if tok in OPERATIONS:
+            return "operations belong in a rule body: 'Name --> op(...)'"
+        return f"a rule is written '{tok} --> body'"
+    if "ARROW" in expected:
+        return "a rule is written 'Name --> body' or 'Name(p1, p2) --> body'"
+    if tok.type == "$END" and expected & {"RPAR", "RBRACE", "RSQB"}:
+        return "a bracket is not closed"
+    if tok.type == "COLON" and "PERCENT" in expected:
+        return "a stochastic choice is written '60%: A'"
+    if tok.type == "EQUAL" and "BINOP" in expected:
+        return "compare with '=='"
+    return None
+
+
+def _translate(e: UnexpectedInput, text: str, path: str) -> BgrSyntaxError:
+    line, column = getattr(e, "line", 0), getattr(e, "column", 0)
+    if isinstance(e, UnexpectedCharacters):
+        char = text[e.pos_in_stream] if e.pos_in_stream < len(text) else "?"
+        if char == '"':
+            message, hint = "unterminated string", 'close the string with " on the same line'
+        elif char == "'" or char == "~":
+            message, hint = f"unexpected '{char}'", "relative ('0.5) and floating (~2) sizes go in split blocks"
+        else:
+            message, hint = f"unexpected character {char!r}", None
+            if char == "-" and text[e.pos_in_stream:e.pos_in_stream + 2] == "->":
+                hint = "a rule arrow is '-->'"
+        return BgrSyntaxError(Diagnostic(path, line, column, message, hint, source_line(text, line)))
+    tok = getattr(e, "token", None)
+    expected = set(getattr(e, "accepts", None) or getattr(e, "expected", None) or ())
+    if isinstance(e, UnexpectedEOF) or (tok is not None and tok.type == "$END"):
+        lines = text.splitlines() or [""]
+        line, column = len(lines), len(lines[-1]) + 1
+        tok = Token("$END", "")
+    words = _describe_expected(expected)
+    message = f"unexpected {_describe_token(tok) if tok is not None else 'input'}"
+    if words:
+        message += "; expected " + (words[0] if len(words) == 1 else ", ".join(words[:-1]) + " or " + words[-1])
+    length = len(tok) if tok is not None and tok.type != "$END" and "\n" not in tok else 1
+    return BgrSyntaxError(Diagnostic(path, line, column, message, _hint(tok, expected),
+                                     source_line(text, line), length))

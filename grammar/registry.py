@@ -1,0 +1,202 @@
+"""Every shape operation and built-in function, declared once.
+
+The checker reads the signatures to validate calls, ``docs/operations.md`` is generated from the
+docs here (``python -m bgr.grammar.registry > docs/operations.md``), and the interpreter looks up
+the implementation of each operation by its name.  Adding an operation means adding one
+:class:`Op` entry here and one function in the interpreter family that ``family`` names.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+# Argument kinds.  A "symbol" kind takes a bare word from a fixed set (``split(x)``,
+# ``roof(hip, 30)``), which the checker validates; the other kinds take expressions.
+NUMBER = "number"  # any numeric expression
+SIZE = "size"  # numeric expression, or 'expr relative to the current scope size
+STRING = "string"  # string expression
+COLOR = "color"  # "#rrggbb" string expression
+AXIS = "axis"  # x | y | z
+AXES = "axes"  # a non-empty combination of x, y, z: xz, xyz ...
+COMP_KIND = "comp kind"  # f (faces)
+ROOF_KIND = "roof kind"  # flat | gable | ...
+GEOMETRY = "geometry"  # a primitive or a declared asset
+
+AXIS_NAMES = ("x", "y", "z")
+COMP_KINDS = ("f",)
+ROOF_KINDS = ("flat", "gable", "hip", "pyramid", "shed", "mansard", "gambrel")
+PRIMITIVES = ("cube", "cylinder", "sphere", "quad", "wedge")
+COMP_SELECTORS = ("front", "back", "left", "right", "side", "top", "bottom", "all")
+OFFSET_SELECTORS = ("inside", "border")
+
+REQUIRED = object()
+
+
+@dataclass(frozen=True)
+class Param:
+    name: str
+    kind: str
+    default: object = REQUIRED
+
+
+@dataclass(frozen=True)
+class Op:
+    name: str
+    family: str  # transforms | splits | components | roofs | inserts | appearance
+    signatures: tuple[tuple[Param, ...], ...]
+    doc: str
+    example: str
+    block: str | None = None  # None, or the kind of block it takes: split | comp | offset
+
+    def arities(self) -> list[tuple[int, int]]:
+        """(least, most) argument counts of each signature."""
+        out = []
+        for sig in self.signatures:
+            least = sum(1 for p in sig if p.default is REQUIRED)
+            out.append((least, len(sig)))
+        return out
+
+    def usage(self) -> str:
+        return " or ".join(f"{self.name}({', '.join(p.name for p in sig)})" for sig in self.signatures)
+
+
+def _sig(*params: Param) -> tuple[tuple[Param, ...], ...]:
+    return (params,)
+
+
+_MATRIX = tuple(Param(f"m{r}{c}", NUMBER) for r in range(3) for c in range(4))
+
+OPERATIONS: dict[str, Op] = {
+    op.name: op
+    for op in [
+        # -- transforms --------------------------------------------------------------------
+        Op("t", "transforms", _sig(Param("x", SIZE), Param("y", SIZE), Param("z", SIZE)),
+           "Translate the scope along its own axes; `'f` is a fraction of the scope size.",
+           "t(0, 0, '0.5)"),
+        Op("r", "transforms", _sig(Param("x", NUMBER), Param("y", NUMBER), Param("z", NUMBER)),
+           "Rotate about the scope origin, in degrees, x then y then z, in scope coordinates.",
+           "r(0, 90, 0)"),
+        Op("s", "transforms", _sig(Param("x", SIZE), Param("y", SIZE), Param("z", SIZE)),
+           "Set the scope size; the geometry is scaled with it. `'f` is relative to the current size.",
+           "s('0.5, '1, 2)"),
+        Op("center", "transforms", _sig(Param("axes", AXES)),
+           "Centre the scope along the given axes on the previous scope (the one saved by the last "
+           "`[`, or the shape the rule received).",
+           "center(xz)"),
+        Op("matrix", "transforms", (_MATRIX,),
+           "Apply a 3x4 affine transform, given row by row, to the scope.",
+           "matrix(1, 0, 0, 2, 0, 1, 0, 0, 0, 0, 1, 0)"),
+        # -- splits ------------------------------------------------------------------------
+        Op("split", "splits", _sig(Param("axis", AXIS)),
+           "Cut the scope along an axis into pieces of absolute (`3`), relative (`'0.25`) and "
+           "floating (`~3`) sizes; `{ ... }*` repeats.",
+           "split(x) { 1: Edge | { ~2: Window }* | 1: Edge }", block="split"),
+        # -- components --------------------------------------------------------------------
+        Op("comp", "components", _sig(Param("kind", COMP_KIND)),
+           "Split a 3D shape into its faces (`f`), each a 2D shape with x along its bottom edge, "
+           "y up and z out.",
+           "comp(f) { top: Roof | side: Facade }", block="comp"),
+        Op("offset", "components", _sig(Param("distance", NUMBER)),
+           "Inset a 2D face by a distance (a negative one grows it) into an inside and a border.",
+           "offset(-0.2) { inside: Glass | border: Frame }", block="offset"),
+        Op("extrude", "components", _sig(Param("height", NUMBER)),
+           "Turn a 2D shape into a prism of the given height along its normal.",
+           "extrude(12)"),
+        Op("taper", "components", _sig(Param("height", NUMBER), Param("ratio", NUMBER)),
+           "Extrude to a height while scaling the top by a ratio.",
+           "taper(30, 0.6)"),
+        # -- roofs -------------------------------------------------------------------------
+        Op("roof", "roofs",
+           _sig(Param("kind", ROOF_KIND), Param("pitch", NUMBER, 30.0), Param("overhang", NUMBER, 0.0)),
+           "Build a roof of the given kind on a 2D footprint: pitch in degrees, overhang in metres.",
+           "roof(hip, 30, 0.5)"),
+        # -- inserts -----------------------------------------------------------------------
+        Op("i", "inserts", _sig(Param("geometry", GEOMETRY)),
+           "Insert a primitive (cube, cylinder, sphere, quad, wedge) or a declared asset, fitted to "
+           "the scope.",
+           "i(cube)"),
+        # -- appearance --------------------------------------------------------------------
+        Op("color", "appearance", (
+            (Param("color", COLOR),),
+            (Param("r", NUMBER), Param("g", NUMBER), Param("b", NUMBER)),
+        ),
+           "Set the colour of the shape and its descendants: a \"#rrggbb\" string or r, g, b in 0..1.",
+           'color("#c8b89a")'),
+        Op("material", "appearance", _sig(Param("name", STRING)),
+           "Set a named material; the name reaches the output file.",
+           'material("brick")'),
+        Op("label", "appearance", _sig(Param("name", STRING)),
+           "Set the semantic label written to outputs (default: the terminal rule's name).",
+           'label("Window")'),
+    ]
+}
+
+
+@dataclass(frozen=True)
+class Builtin:
+    name: str
+    least: int
+    most: int | None  # None: any number
+    doc: str
+
+
+BUILTINS: dict[str, Builtin] = {
+    b.name: b
+    for b in [
+        Builtin("rand", 0, 2, "rand() in [0, 1), rand(b) in [0, b), rand(a, b) in [a, b): a uniform draw from the shape's stream."),
+        Builtin("randint", 2, 2, "randint(a, b): a whole number from a to b inclusive."),
+        Builtin("floor", 1, 1, "Round down."),
+        Builtin("ceil", 1, 1, "Round up."),
+        Builtin("round", 1, 1, "Round to the nearest whole number (halves away from zero)."),
+        Builtin("abs", 1, 1, "Absolute value."),
+        Builtin("min", 2, None, "The least of two or more numbers."),
+        Builtin("max", 2, None, "The greatest of two or more numbers."),
+        Builtin("sqrt", 1, 1, "Square root."),
+        Builtin("sin", 1, 1, "Sine of an angle in degrees."),
+        Builtin("cos", 1, 1, "Cosine of an angle in degrees."),
+        Builtin("tan", 1, 1, "Tangent of an angle in degrees."),
+        Builtin("clamp", 3, 3, "clamp(x, lo, hi)."),
+    ]
+}
+
+# Names the interpreter provides while deriving a shape (LANGUAGE.md section 8).
+BUILTIN_NAMES: dict[str, str] = {
+    "scope.sx": "scope size along x", "scope.sy": "scope size along y", "scope.sz": "scope size along z",
+    "scope.x": "scope origin x in the parent frame", "scope.y": "scope origin y", "scope.z": "scope origin z",
+    "split.index": "0-based index of the piece in the enclosing split (global across repetitions)",
+    "split.total": "number of pieces of the enclosing split",
+    "comp.index": "0-based index of the face in the enclosing component split",
+    "comp.total": "number of faces of the enclosing component split",
+    "depth": "derivation depth of the shape", "seed": "the global seed",
+}
+
+KEYWORDS = ("version", "import", "as", "attr", "const", "func", "start", "asset", "terminal",
+            "case", "else", "NIL", "true", "false", "and", "or", "not")
+
+
+def reference_markdown() -> str:
+    """The operation and function reference, generated from this registry (docs/operations.md)."""
+    out = ["# Operations and built-in functions", "",
+           "Generated from `grammar/registry.py` by `python -m bgr.grammar.registry`; do not edit.", ""]
+    families = ["transforms", "splits", "components", "roofs", "inserts", "appearance"]
+    for family in families:
+        out += [f"## {family.capitalize()}", "", "| operation | meaning | example |", "|---|---|---|"]
+        for op in OPERATIONS.values():
+            if op.family == family:
+                out.append(f"| `{op.usage()}` | {op.doc} | `{op.example}` |")
+        out.append("")
+    out += ["## Built-in functions", "", "| function | meaning |", "|---|---|"]
+    for b in BUILTINS.values():
+        out.append(f"| `{b.name}` | {b.doc} |")
+    out += ["", "## Built-in names", "", "| name | meaning |", "|---|---|"]
+    for name, doc in BUILTIN_NAMES.items():
+        out.append(f"| `{name}` | {doc} |")
+    out += ["", "Symbols: roof kinds " + ", ".join(f"`{k}`" for k in ROOF_KINDS)
+            + "; primitives " + ", ".join(f"`{p}`" for p in PRIMITIVES)
+            + "; component selectors " + ", ".join(f"`{s}`" for s in COMP_SELECTORS)
+            + ", `face(i)`; offset selectors `inside`, `border`.", ""]
+    return "\n".join(out)
+
+
+if __name__ == "__main__":
+    print(reference_markdown(), end="")

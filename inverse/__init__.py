@@ -1,0 +1,1 @@
+"""Inverse modules that write .bgr grammars from data (not written yet)."""

@@ -1,0 +1,1 @@
+"""The .bgr standard library: modules imported as ``import stdlib.NAME as alias``."""
