@@ -7,7 +7,6 @@ file involved is collected and raised together as one :class:`BgrError`.
 
 from __future__ import annotations
 
-import gc
 import os
 from pathlib import Path
 
@@ -104,7 +103,7 @@ class Loader:
             shown = f"stdlib/{parts[1]}.bgr"
         else:
             target = folder / item.path
-            shown = os.path.relpath(target) if not Path(item.path).is_absolute() else item.path
+            shown = _display(target)
             if not target.is_file():
                 fail(f"cannot find the imported file '{item.path}'", f"looked for {target}")
                 return None
@@ -152,23 +151,27 @@ def load(source: str | bytes | os.PathLike, path: str | None = None) -> Grammar:
     if path is not None and key is None and Path(path).suffix == ".bgr":
         key = str(Path(path).resolve())
     loader = Loader()
-    was_enabled = gc.isenabled()
-    gc.disable()  # parsing makes many small objects and no cycles; collection only slows it
     try:
         grammar = loader.load_text(text, path or "<text>", key, (key,) if key else ())
     except RecursionError:
         raise BgrSyntaxError(Diagnostic(path or "<text>", 0, 0,
                                         "the grammar nests expressions or blocks too deeply to process",
                                         "split deep nesting into separate rules")) from None
-    finally:
-        if was_enabled:
-            gc.enable()
     if loader.diagnostics:
         unique = {(d.path, d.line, d.column, d.message): d for d in loader.diagnostics}
         ordered = sorted(unique.values(), key=lambda d: (d.path != (path or "<text>"), d.path, d.line, d.column))
         raise (BgrSyntaxError if grammar is None else BgrCheckError)(ordered)
     assert grammar is not None
     return grammar
+
+
+def _display(path: Path) -> str:
+    """A path as messages show it: relative to the working folder when inside it."""
+    try:
+        rel = os.path.relpath(path)
+    except ValueError:  # another drive on Windows
+        return str(path)
+    return str(path) if rel.startswith("..") else rel
 
 
 def _looks_like_path(source: object) -> bool:

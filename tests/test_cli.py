@@ -1,0 +1,85 @@
+"""The command line: check, fmt, version, exit statuses, atomic writes."""
+
+import os
+import subprocess
+import sys
+
+import pytest
+
+from bgr.cli import main
+
+MESSY = "A-->extrude(3)B\nB-->NIL\n"
+CLEAN = "A --> extrude(3) B\nB --> NIL\n"
+
+
+def run(*args, stdin=None):
+    return subprocess.run([sys.executable, "-m", "bgr", *args], capture_output=True, text=True, input=stdin)
+
+
+def test_version_and_help():
+    out = run("--version")
+    assert out.returncode == 0 and out.stdout.startswith("bgr ")
+    out = run("--help")
+    assert out.returncode == 0 and "check" in out.stdout and "fmt" in out.stdout
+
+
+def test_no_command_is_bad_usage():
+    assert run().returncode == 2
+
+
+def test_check_every_shipped_grammar(root):
+    files = [str(p) for p in sorted(root.glob("examples/*.bgr")) + sorted(root.glob("stdlib/*.bgr"))]
+    out = run("check", *files)
+    assert out.returncode == 0, out.stderr
+    assert out.stdout.count(": ok") == len(files)
+
+
+def test_check_reports_every_file(tmp_path, capsys):
+    good, bad = tmp_path / "good.bgr", tmp_path / "bad.bgr"
+    good.write_text(CLEAN)
+    bad.write_text("A --> Nope\n")
+    assert main(["check", str(bad), str(good)]) == 1
+    captured = capsys.readouterr()
+    assert "bad.bgr:1:7: error: unknown rule 'Nope'" in captured.err
+    assert "good.bgr: ok" in captured.out
+
+
+def test_fmt_prints_checks_and_writes(tmp_path, capsys):
+    f = tmp_path / "m.bgr"
+    f.write_text(MESSY)
+    assert main(["fmt", str(f)]) == 0
+    assert capsys.readouterr().out == CLEAN
+    assert main(["fmt", "--check", str(f)]) == 1
+    assert "not formatted" in capsys.readouterr().err
+    os.chmod(f, 0o640)
+    assert main(["fmt", "-w", str(f)]) == 0
+    assert f.read_text() == CLEAN and (f.stat().st_mode & 0o777) == 0o640
+    assert main(["fmt", "--check", str(f)]) == 0
+    assert [p.name for p in tmp_path.iterdir()] == ["m.bgr"]  # no temporary file left behind
+
+
+def test_fmt_of_a_broken_file_changes_nothing(tmp_path, capsys):
+    f = tmp_path / "broken.bgr"
+    f.write_text("A --> extrude(\n")
+    assert main(["fmt", "-w", str(f)]) == 1
+    assert f.read_text() == "A --> extrude(\n"
+    assert "broken.bgr:1:" in capsys.readouterr().err
+
+
+def test_fmt_reads_standard_input():
+    out = run("fmt", "-", stdin=MESSY)
+    assert out.returncode == 0 and out.stdout == CLEAN
+
+
+def test_fmt_usage_errors(tmp_path):
+    a, b = tmp_path / "a.bgr", tmp_path / "b.bgr"
+    a.write_text(CLEAN)
+    b.write_text(CLEAN)
+    assert run("fmt", str(a), str(b)).returncode == 2
+    assert run("fmt", "--check", "-w", str(a)).returncode == 2
+
+
+@pytest.mark.parametrize("args", [["check", "/no/such/file.bgr"], ["fmt", "/no/such/file.bgr"]])
+def test_missing_files_are_bad_input_not_tracebacks(args):
+    out = run(*args)
+    assert out.returncode == 1 and "no such file" in out.stderr and "Traceback" not in out.stderr
