@@ -75,7 +75,7 @@ def cmd_check(args) -> int:
             status = EXIT_INPUT
             continue
         if not args.quiet:
-            print(f"{name}: ok")
+            print(f"{'<stdin>' if name == '-' else name}: ok")
     return status
 
 

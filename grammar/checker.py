@@ -13,8 +13,8 @@ from dataclasses import dataclass, field
 from . import nodes as n
 from .errors import Diagnostic, source_line, suggest
 from .registry import (AXES, AXIS, AXIS_NAMES, BUILTIN_NAMES, BUILTINS, COLOR, COMP_KIND, COMP_KINDS,
-                       COMP_SELECTORS, GEOMETRY, NUMBER, OFFSET_SELECTORS, OPERATIONS, PRIMITIVES,
-                       REQUIRED, ROOF_KIND, ROOF_KINDS, SIZE, STRING, Op)
+                       COMP_SELECTORS, GEOMETRY, KEYWORDS, NUMBER, OFFSET_SELECTORS, OPERATIONS,
+                       PRIMITIVES, ROOF_KIND, ROOF_KINDS, SIZE, STRING, Op)
 
 KNOWN_VERSIONS = (1,)
 _COLOR_RE = re.compile(r"#[0-9a-fA-F]{6}\Z")
@@ -87,6 +87,10 @@ class Checker:
         first_seen: dict[tuple[str, str], n.Pos] = {}
 
         def declare(space: str, name: str, pos: n.Pos, what: str) -> bool:
+            if name in KEYWORDS:
+                self.error(pos, f"'{name}' is a keyword and cannot name {_article(what)}",
+                           "choose another name")
+                return False
             key = (space, name)
             if key in first_seen:
                 self.error(pos, f"duplicate {what} '{name}'",
@@ -113,7 +117,7 @@ class Checker:
                                "choose another name, e.g. a capitalised one", len(item.name))
                 elif declare("rule", item.name, item.pos, "rule"):
                     g.rules[item.name] = item
-                self.unique_params(item.params, item.pos, "rule")
+                self.unique_params(item, "rule")
             elif isinstance(item, n.TerminalDecl):
                 for name in item.names:
                     if declare("rule", name, item.pos, "rule or terminal"):
@@ -129,18 +133,19 @@ class Checker:
                     self.error(item.pos, f"'{item.name}' is a built-in function and cannot be redefined")
                 elif declare("func", item.name, item.pos, "func"):
                     g.funcs[item.name] = item
-                self.unique_params(item.params, item.pos, "func")
+                self.unique_params(item, "func")
             elif isinstance(item, n.Asset):
                 if item.name in PRIMITIVES:
                     self.error(item.pos, f"'{item.name}' is a built-in primitive and cannot name an asset")
                 elif declare("asset", item.name, item.pos, "asset"):
                     g.assets[item.name] = item
             elif isinstance(item, n.Import):
+                where = item.alias_pos if item.alias_pos.line else item.pos
                 if item.alias in _RESERVED_ALIASES:
-                    self.error(item.pos, f"'{item.alias}' is reserved and cannot be an import alias",
+                    self.error(where, f"'{item.alias}' is reserved and cannot be an import alias",
                                f"write e.g. 'as {item.alias[:3]}_lib'")
                 else:
-                    declare("alias", item.alias, item.pos, "import alias")
+                    declare("alias", item.alias, where, "import alias")
             elif isinstance(item, n.Start):
                 starts += 1
                 if starts > 1:
@@ -156,11 +161,15 @@ class Checker:
         if g.start is None and g.rules:
             g.start = next(iter(g.rules))
 
-    def unique_params(self, params: list[str], pos: n.Pos, what: str) -> None:
+    def unique_params(self, item: n.Rule | n.Func, what: str) -> None:
         seen = set()
-        for p in params:
+        for i, p in enumerate(item.params):
+            if p in KEYWORDS:
+                pos = item.param_pos[i] if i < len(item.param_pos) else item.pos
+                self.error(pos, f"'{p}' is a keyword and cannot name a parameter", length=len(p))
             if p in seen:
-                self.error(pos, f"parameter '{p}' appears twice in this {what}")
+                pos = item.param_pos[i] if i < len(item.param_pos) else item.pos
+                self.error(pos, f"parameter '{p}' appears twice in this {what}", length=len(p))
             seen.add(p)
 
     # ---- rules ----------------------------------------------------------------------------
@@ -234,7 +243,12 @@ class Checker:
             hint = suggest(member, known)
             if hint is None and module is self.g:
                 hint = f"define it with '{member} --> ...' or declare it with 'terminal {member}'"
-            where = f"module '{step.name.split('.')[0]}' has no rule" if module is not self.g else "unknown rule"
+            if module is not self.g:
+                where = f"module '{step.name.split('.')[0]}' has no rule"
+            elif member[:1].islower() and step.args:
+                where = "unknown operation or rule"
+            else:
+                where = "unknown rule"
             self.error(step.pos, f"{where} '{member}'", hint, len(step.name))
 
     def unknown_alias(self, alias: str, pos: n.Pos) -> None:
@@ -260,7 +274,10 @@ class Checker:
                        len(op.name))
             return
         if step.block.repeat and op.block != "split":
-            self.error(step.block.pos, f"only split blocks repeat; '{op.name}' {{ ... }}* has a '*'")
+            end = step.block.pos
+            star = n.Pos(end.end_line, end.end_column - 1, end.end_line, end.end_column)
+            self.error(star, f"only split blocks repeat; '{op.name}' {{ ... }} cannot take a '*'",
+                       "remove the '*'")
         self.block_entries(step.block.entries, op, local, in_group=False)
 
     def pick_signature(self, op: Op, step: n.Operation):
@@ -269,7 +286,8 @@ class Checker:
             if least <= count <= most:
                 return sig
         counts = " or ".join(str(a) if a == b else f"{a} to {b}" for a, b in op.arities())
-        self.error(step.pos, f"'{op.name}' takes {counts} arguments, given {count}",
+        noun = "argument" if counts == "1" else "arguments"
+        self.error(step.pos, f"'{op.name}' takes {counts} {noun}, given {count}",
                    f"write {op.usage()}", len(op.name))
         return None
 
@@ -435,7 +453,9 @@ class Checker:
             if count < b.least or (b.most is not None and count > b.most):
                 want = str(b.least) if b.least == b.most else (
                     f"{b.least} or more" if b.most is None else f"{b.least} to {b.most}")
-                self.error(e.pos, f"'{name}' takes {want} arguments, given {count}", b.doc, len(name))
+                noun = "argument" if want == "1" else "arguments"
+                self.error(e.pos, f"'{name}' takes {want} {noun}, given {count}", f"{b.usage}: {b.doc}",
+                           len(name))
             return
         module, member = self.g.lookup_module(name)
         if "." in name and name.split(".", 1)[0] in self.broken_aliases:
@@ -502,6 +522,10 @@ def _names(e):
             stack += (e.cond, e.then, e.otherwise)
         elif isinstance(e, n.Call):
             stack += e.args
+
+
+def _article(what: str) -> str:
+    return ("an " if what[0] in "aeiou" else "a ") + what
 
 
 def _count(k: int, word: str) -> str:

@@ -221,6 +221,7 @@ class Rule:
     params: list[str]
     body: Body
     pos: Pos = _pos()
+    param_pos: list[Pos] = field(default_factory=list, compare=False, repr=False, kw_only=True)
 
 
 @dataclass
@@ -237,6 +238,7 @@ class Import:
     path: str | None = None
     module: str | None = None
     pos: Pos = _pos()
+    alias_pos: Pos = _pos()
 
 
 @dataclass
@@ -259,6 +261,7 @@ class Func:
     params: list[str]
     body: Expr
     pos: Pos = _pos()
+    param_pos: list[Pos] = field(default_factory=list, compare=False, repr=False, kw_only=True)
 
 
 @dataclass

@@ -27,7 +27,7 @@ def _first(x):
     """The first source position inside a child (a token, a node, or a list of them)."""
     if isinstance(x, Token):
         return (x.line, x.column)
-    pos = getattr(x, "pos", None)
+    pos = x if isinstance(x, n.Pos) else getattr(x, "pos", None)
     if pos is not None and pos.line:
         return (pos.line, pos.column)
     if isinstance(x, (list, tuple)):
@@ -41,7 +41,7 @@ def _first(x):
 def _last(x):
     if isinstance(x, Token):
         return (x.end_line, x.end_column)
-    pos = getattr(x, "pos", None)
+    pos = x if isinstance(x, n.Pos) else getattr(x, "pos", None)
     if pos is not None and pos.line:
         return (pos.end_line, pos.end_column)
     if isinstance(x, (list, tuple)):
@@ -103,10 +103,10 @@ class _TreeBuilder(Transformer):
         return n.Version(_number(c[0]), pos=_span(c))
 
     def import_file(self, c):
-        return n.Import(str(c[1]), path=_unescape(c[0]), pos=_span(c))
+        return n.Import(str(c[1]), path=_unescape(c[0]), pos=_span(c), alias_pos=_tok_pos(c[1]))
 
     def import_module(self, c):
-        return n.Import(str(c[1]), module=str(c[0]), pos=_span(c))
+        return n.Import(str(c[1]), module=str(c[0]), pos=_span(c), alias_pos=_tok_pos(c[1]))
 
     def attr_decl(self, c):
         return n.Attr(str(c[0]), c[1], pos=_span(c))
@@ -115,7 +115,9 @@ class _TreeBuilder(Transformer):
         return n.Const(str(c[0]), c[1], pos=_span(c))
 
     def func_decl(self, c):
-        return n.Func(str(c[0]), c[1] or [], c[2], pos=_span(c))
+        params = c[1] or []
+        return n.Func(str(c[0]), [str(p) for p in params], c[2], pos=_span(c),
+                      param_pos=[_tok_pos(p) for p in params])
 
     def asset_decl(self, c):
         return n.Asset(str(c[0]), _unescape(c[1]), pos=_span(c))
@@ -139,7 +141,8 @@ class _TreeBuilder(Transformer):
         if str(name_tok) in KEYWORDS:
             raise _Problem(_tok_pos(name_tok), f"'{name_tok}' is a keyword and cannot name a rule",
                            "choose another name, e.g. a capitalised one", len(name_tok))
-        return n.Rule(str(name_tok), [str(p) for p in params], body, pos=_span(c))
+        return n.Rule(str(name_tok), [str(p) for p in params], body, pos=_span(c),
+                      param_pos=[_tok_pos(p) for p in params])
 
     def rule_params(self, c):
         return c[0] if c and c[0] else []
@@ -194,36 +197,40 @@ class _TreeBuilder(Transformer):
         return n.Successor(name, args, pos=_span(c))
 
     def block(self, c):
-        return n.Block(c[0], repeat=c[2] is not None, pos=_span(c))
+        return n.Block(c[1], repeat=c[3] is not None, pos=_span(c))
 
     def entries(self, c):
         return list(c)
 
     def keyed(self, c):
-        kind, key = c[0]
-        return n.Entry(kind, key, c[1], pos=_span(key, c[1]))
+        kind, key, start = c[0]
+        return n.Entry(kind, key, c[1], pos=_span(start, c[1]))
 
     def group(self, c):
-        return n.Group(c[0], pos=_span(c))
+        return n.Group(c[1], pos=_span(c))
 
     def key_abs(self, c):
-        return ("abs", c[0])
+        return ("abs", c[0], c[0])
 
     def key_rel(self, c):
-        return ("rel", c[0])
+        return ("rel", c[1], c[0])
 
     def key_float(self, c):
-        return ("float", c[0])
+        return ("float", c[1], c[0])
 
     def args(self, c):
         return list(c)
 
     def rel_arg(self, c):
-        return n.Relative(c[0], pos=_span(c))
+        return n.Relative(c[1], pos=_span(c))
 
     # ---- expressions ----------------------------------------------------------------------
     def number(self, c):
         return n.Number(_number(c[0]), pos=_tok_pos(c[0]))
+
+    def signed_number(self, c):
+        value = _number(c[1])
+        return n.Number(-value if c[0] == "-" else value, pos=_span(c))
 
     def string(self, c):
         return n.String(_unescape(c[0]), pos=_tok_pos(c[0]))
@@ -411,6 +418,8 @@ def _describe_expected(expected: set[str]) -> list[str]:
 
 
 def _describe_token(tok: Token) -> str:
+    if tok == "'":
+        return "\"'\""
     if tok.type == "$END":
         return "end of file"
     if tok.type in ("NAME", "RULE_NAME"):
@@ -433,6 +442,8 @@ def _hint(tok: Token | None, expected: set[str]) -> str | None:
         return "a rule is written 'Name --> body' or 'Name(p1, p2) --> body'"
     if tok.type == "$END" and expected & {"RPAR", "RBRACE", "RSQB"}:
         return "a bracket is not closed"
+    if tok.type in ("QUOTE", "TILDE"):
+        return "relative sizes ('0.5) go in s(), t() and split blocks; floating sizes (~2) in split blocks"
     if tok.type == "COLON" and "PERCENT" in expected:
         return "a stochastic choice is written '60%: A'"
     if tok.type == "EQUAL" and "BINOP" in expected:
@@ -455,6 +466,9 @@ def _translate(e: UnexpectedInput, text: str, path: str) -> BgrSyntaxError:
         return BgrSyntaxError(Diagnostic(path, line, column, message, hint, source_line(text, line)))
     tok = getattr(e, "token", None)
     expected = set(getattr(e, "accepts", None) or getattr(e, "expected", None) or ())
+    special = _arrow_mistake(tok, text, path) if tok is not None and tok.type != "$END" else None
+    if special is not None:
+        return special
     if isinstance(e, UnexpectedEOF) or (tok is not None and tok.type == "$END"):
         lines = text.splitlines() or [""]
         line, column = len(lines), len(lines[-1]) + 1
@@ -466,3 +480,45 @@ def _translate(e: UnexpectedInput, text: str, path: str) -> BgrSyntaxError:
     length = len(tok) if tok is not None and tok.type != "$END" and "\n" not in tok else 1
     return BgrSyntaxError(Diagnostic(path, line, column, message, _hint(tok, expected),
                                      source_line(text, line), length))
+
+
+def _line_col(text: str, index: int) -> tuple[int, int]:
+    return text.count("\n", 0, index) + 1, index - (text.rfind("\n", 0, index) + 1) + 1
+
+
+def _arrow_mistake(tok: Token, text: str, path: str) -> BgrSyntaxError | None:
+    """Two slips the grammar alone reports badly: '->' for '-->', and a rule with an empty body
+    (the next rule's name is then read as a successor, and its '-->' is what looks wrong)."""
+    start = tok.start_pos if tok.start_pos is not None else 0
+    after = start + len(tok)
+    while after < len(text) and text[after] in " \t":
+        after += 1
+    for at in (start, after):
+        if text.startswith("->", at) and not text.startswith("-->", at - 1):
+            line, col = _line_col(text, at)
+            return BgrSyntaxError(Diagnostic(path, line, col, "'->' is not the rule arrow", "write '-->'",
+                                             source_line(text, line), 2))
+    if not text.startswith("-->", start):
+        return None
+    # `A -->` then `B --> ...`: walk back over B (and its parameters) to the arrow before it
+    j = start
+    while j > 0 and text[j - 1].isspace():
+        j -= 1
+    if j > 0 and text[j - 1] == ")":
+        j = max(text.rfind("(", 0, j), 0)
+    name_end = j
+    while j > 0 and (text[j - 1].isalnum() or text[j - 1] == "_"):
+        j -= 1
+    name = text[j:name_end]
+    k = j
+    while k > 0 and text[k - 1].isspace():
+        k -= 1
+    if name and text.endswith("-->", 0, k):
+        line, col = _line_col(text, k)
+        return BgrSyntaxError(Diagnostic(
+            path, line, col, f"empty rule body (the next line starts the rule '{name}')",
+            "a body needs at least one step: write NIL to delete the shape", source_line(text, line)))
+    line, col = _line_col(text, start)
+    return BgrSyntaxError(Diagnostic(path, line, col, "unexpected '-->'",
+                                     "a rule is written 'Name --> body', one arrow per rule",
+                                     source_line(text, line), 3))

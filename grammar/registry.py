@@ -1,7 +1,7 @@
 """Every shape operation and built-in function, declared once.
 
 The checker reads the signatures to validate calls, ``docs/operations.md`` is generated from the
-docs here (``python -m bgr.grammar.registry > docs/operations.md``), and the interpreter looks up
+docs here (``python -m bgr.grammar.reference > docs/operations.md``), and the interpreter looks up
 the implementation of each operation by its name.  Adding an operation means adding one
 :class:`Op` entry here and one function in the interpreter family that ``family`` names.
 """
@@ -137,25 +137,27 @@ class Builtin:
     name: str
     least: int
     most: int | None  # None: any number
+    usage: str
     doc: str
 
 
 BUILTINS: dict[str, Builtin] = {
     b.name: b
     for b in [
-        Builtin("rand", 0, 2, "rand() in [0, 1), rand(b) in [0, b), rand(a, b) in [a, b): a uniform draw from the shape's stream."),
-        Builtin("randint", 2, 2, "randint(a, b): a whole number from a to b inclusive."),
-        Builtin("floor", 1, 1, "Round down."),
-        Builtin("ceil", 1, 1, "Round up."),
-        Builtin("round", 1, 1, "Round to the nearest whole number (halves away from zero)."),
-        Builtin("abs", 1, 1, "Absolute value."),
-        Builtin("min", 2, None, "The least of two or more numbers."),
-        Builtin("max", 2, None, "The greatest of two or more numbers."),
-        Builtin("sqrt", 1, 1, "Square root."),
-        Builtin("sin", 1, 1, "Sine of an angle in degrees."),
-        Builtin("cos", 1, 1, "Cosine of an angle in degrees."),
-        Builtin("tan", 1, 1, "Tangent of an angle in degrees."),
-        Builtin("clamp", 3, 3, "clamp(x, lo, hi)."),
+        Builtin("rand", 0, 2, "rand(a, b)", "a uniform draw from the shape's stream: rand() in [0, 1), "
+                "rand(b) in [0, b), rand(a, b) in [a, b)."),
+        Builtin("randint", 2, 2, "randint(a, b)", "a whole number from a to b inclusive."),
+        Builtin("floor", 1, 1, "floor(x)", "round down."),
+        Builtin("ceil", 1, 1, "ceil(x)", "round up."),
+        Builtin("round", 1, 1, "round(x)", "round to the nearest whole number (halves away from zero)."),
+        Builtin("abs", 1, 1, "abs(x)", "absolute value."),
+        Builtin("min", 2, None, "min(a, b, ...)", "the least of two or more numbers."),
+        Builtin("max", 2, None, "max(a, b, ...)", "the greatest of two or more numbers."),
+        Builtin("sqrt", 1, 1, "sqrt(x)", "square root."),
+        Builtin("sin", 1, 1, "sin(deg)", "sine of an angle in degrees."),
+        Builtin("cos", 1, 1, "cos(deg)", "cosine of an angle in degrees."),
+        Builtin("tan", 1, 1, "tan(deg)", "tangent of an angle in degrees."),
+        Builtin("clamp", 3, 3, "clamp(x, lo, hi)", "x limited to the range lo..hi."),
     ]
 }
 
@@ -172,31 +174,3 @@ BUILTIN_NAMES: dict[str, str] = {
 
 KEYWORDS = ("version", "import", "as", "attr", "const", "func", "start", "asset", "terminal",
             "case", "else", "NIL", "true", "false", "and", "or", "not")
-
-
-def reference_markdown() -> str:
-    """The operation and function reference, generated from this registry (docs/operations.md)."""
-    out = ["# Operations and built-in functions", "",
-           "Generated from `grammar/registry.py` by `python -m bgr.grammar.registry`; do not edit.", ""]
-    families = ["transforms", "splits", "components", "roofs", "inserts", "appearance"]
-    for family in families:
-        out += [f"## {family.capitalize()}", "", "| operation | meaning | example |", "|---|---|---|"]
-        for op in OPERATIONS.values():
-            if op.family == family:
-                out.append(f"| `{op.usage()}` | {op.doc} | `{op.example}` |")
-        out.append("")
-    out += ["## Built-in functions", "", "| function | meaning |", "|---|---|"]
-    for b in BUILTINS.values():
-        out.append(f"| `{b.name}` | {b.doc} |")
-    out += ["", "## Built-in names", "", "| name | meaning |", "|---|---|"]
-    for name, doc in BUILTIN_NAMES.items():
-        out.append(f"| `{name}` | {doc} |")
-    out += ["", "Symbols: roof kinds " + ", ".join(f"`{k}`" for k in ROOF_KINDS)
-            + "; primitives " + ", ".join(f"`{p}`" for p in PRIMITIVES)
-            + "; component selectors " + ", ".join(f"`{s}`" for s in COMP_SELECTORS)
-            + ", `face(i)`; offset selectors `inside`, `border`.", ""]
-    return "\n".join(out)
-
-
-if __name__ == "__main__":
-    print(reference_markdown(), end="")
