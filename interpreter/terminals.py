@@ -1,0 +1,93 @@
+"""The terminal table: one row per terminal shape, as numpy arrays, and the unit meshes they use.
+
+Terminals are data, not objects.  While deriving, rows are appended to Python lists (cheap);
+``TerminalTable.freeze()`` turns them into arrays once.  Every terminal points at a *unit mesh*:
+vertices in unit scope coordinates (each axis 0..1 of the scope's size), so that one mesh serves
+every terminal of that shape — all the window quads of a city share one — and the writers
+transform them in bulk (``world = origin + (v * size) @ axes``) or instance them.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+
+@dataclass
+class UnitMesh:
+    """Triangles in unit scope coordinates.  ``name`` is what the JSON's ``geometry`` says."""
+
+    name: str
+    vertices: np.ndarray  # (V, 3) float64, in [0, 1] per scope axis
+    faces: np.ndarray  # (F, 3) int32, counter-clockwise seen from outside
+
+    def __post_init__(self) -> None:
+        self.vertices = np.ascontiguousarray(self.vertices, dtype=np.float64).reshape(-1, 3)
+        self.faces = np.ascontiguousarray(self.faces, dtype=np.int32).reshape(-1, 3)
+
+
+class MeshLibrary:
+    """Unit meshes by id; identical meshes (same name and bytes) are stored once."""
+
+    def __init__(self) -> None:
+        self.meshes: list[UnitMesh] = []
+        self._index: dict[tuple, int] = {}
+
+    def add(self, mesh: UnitMesh, key: tuple | None = None) -> int:
+        if key is None:
+            key = (mesh.name, mesh.vertices.round(12).tobytes(), mesh.faces.tobytes())
+        found = self._index.get(key)
+        if found is None:
+            found = self._index[key] = len(self.meshes)
+            self.meshes.append(mesh)
+        return found
+
+
+@dataclass
+class TerminalTable:
+    """Columns of the terminal list (LANGUAGE.md section 11), in derivation order."""
+
+    label: list[str] = field(default_factory=list)
+    rule: list[str] = field(default_factory=list)
+    path: list[str] = field(default_factory=list)
+    origin: list = field(default_factory=list)  # frozen: (N, 3)
+    axes: list = field(default_factory=list)  # frozen: (N, 3, 3), rows are the unit x, y, z axes
+    size: list = field(default_factory=list)  # frozen: (N, 3)
+    color: list = field(default_factory=list)  # frozen: (N, 3) in 0..1
+    material: list = field(default_factory=list)  # str or None
+    mesh: list = field(default_factory=list)  # frozen: (N,) int32 ids into library
+    library: MeshLibrary = field(default_factory=MeshLibrary)
+    frozen: bool = False
+
+    def __len__(self) -> int:
+        return len(self.label)
+
+    def freeze(self) -> "TerminalTable":
+        if not self.frozen:
+            self.origin = np.asarray(self.origin, dtype=np.float64).reshape(-1, 3)
+            self.axes = np.asarray(self.axes, dtype=np.float64).reshape(-1, 3, 3)
+            self.size = np.asarray(self.size, dtype=np.float64).reshape(-1, 3)
+            self.color = np.asarray(self.color, dtype=np.float64).reshape(-1, 3)
+            self.mesh = np.asarray(self.mesh, dtype=np.int32).reshape(-1)
+            self.frozen = True
+        return self
+
+    def geometry_names(self) -> list[str]:
+        names = [m.name for m in self.library.meshes]
+        return [names[i] for i in self.mesh]
+
+    def triangle_count(self) -> int:
+        per_mesh = np.array([len(m.faces) for m in self.library.meshes] or [0], dtype=np.int64)
+        return int(per_mesh[self.mesh].sum()) if len(self) else 0
+
+
+def color_hex(rgb) -> str:
+    r, g, b = (int(round(min(max(c, 0.0), 1.0) * 255)) for c in rgb)
+    return f"#{r:02x}{g:02x}{b:02x}"
+
+
+def world_vertices(table: TerminalTable, rows: np.ndarray, mesh: UnitMesh) -> np.ndarray:
+    """(len(rows), V, 3) world positions of one unit mesh placed at the given terminals."""
+    local = mesh.vertices[None, :, :] * table.size[rows][:, None, :]
+    return table.origin[rows][:, None, :] + np.einsum("nvk,nkj->nvj", local, table.axes[rows])
