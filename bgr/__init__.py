@@ -5,6 +5,7 @@ The public Python API::
     import bgr
     grammar = bgr.load("house.bgr")        # parse, resolve imports, check; raises bgr.BgrError
     text = bgr.format_source(open("house.bgr").read())   # canonical layout, comments kept
+    result = bgr.derive(grammar, seed=3)     # terminals as a table; result.save("house.glb")
 """
 
 from importlib.metadata import PackageNotFoundError, version as _version
@@ -14,11 +15,12 @@ from .grammar.errors import BgrCheckError, BgrError, BgrSyntaxError, Diagnostic
 from .grammar.formatter import format_module, format_source
 from .grammar.loader import load
 from .grammar.parser import parse
+from .interpreter.derive import Result, derive
 
 try:
     __version__ = _version("bgr")
 except PackageNotFoundError:  # pragma: no cover - running from a source tree without install
     __version__ = "0+unknown"
 
-__all__ = ["load", "parse", "format_source", "format_module", "Grammar", "BgrError",
+__all__ = ["load", "derive", "Result", "parse", "format_source", "format_module", "Grammar", "BgrError",
            "BgrSyntaxError", "BgrCheckError", "Diagnostic", "__version__"]

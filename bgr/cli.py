@@ -32,7 +32,7 @@ class _Parser(argparse.ArgumentParser):
 
 def build_parser() -> argparse.ArgumentParser:
     parser = _Parser(prog="bgr", description="bgr: a building-grammar toolkit. "
-                     "Write .bgr shape grammars, check them and format them.",
+                     "Write .bgr shape grammars, check and format them, derive them into meshes.",
                      epilog="Exit status: 0 success, 1 bad input, 2 bad usage. "
                      "Language reference: docs/language.md.")
     parser.add_argument("--version", action="version", version=f"bgr {__version__}")
@@ -43,6 +43,22 @@ def build_parser() -> argparse.ArgumentParser:
                                 "report every error found. Exit 0 when all files are clean.")
     check.add_argument("files", nargs="+", metavar="FILE", help=".bgr files ('-' reads standard input)")
     check.add_argument("-q", "--quiet", action="store_true", help="print nothing for clean files")
+
+    derive = commands.add_parser("derive", help="derive a grammar into a mesh or a terminal list",
+                                 description="Derive FILE.bgr on a lot and write the result; the "
+                                 "format follows the output's extension (.glb .gltf .obj .ply .stl .json).")
+    derive.add_argument("file", metavar="FILE.bgr")
+    derive.add_argument("-o", "--output", metavar="OUT", help="output file ('-' with --format json: stdout)")
+    derive.add_argument("--format", choices=["glb", "gltf", "obj", "ply", "stl", "json"],
+                        help="output format when the extension does not say it (json for stdout)")
+    derive.add_argument("--seed", type=int, default=0, help="global random seed (default 0)")
+    derive.add_argument("--set", action="append", default=[], metavar="NAME=VALUE",
+                        help="override an attr; repeatable")
+    derive.add_argument("--lot", metavar="W,D|LOTS.geojson",
+                        help="the lot: width,depth in metres (default 20,20) or GeoJSON footprints")
+    derive.add_argument("--max-depth", type=int, default=256, metavar="N", help="rule depth limit (256)")
+    derive.add_argument("--max-shapes", type=int, default=10_000_000, metavar="N",
+                        help="shape budget (10,000,000)")
 
     fmt = commands.add_parser("fmt", help="print files in the canonical layout",
                               description="Format .bgr files in the canonical layout, keeping "
@@ -124,7 +140,48 @@ def write_atomic(path: Path, text: str) -> None:
         raise
 
 
-COMMANDS = {"check": cmd_check, "fmt": cmd_fmt}
+def _parse_value(text: str):
+    """--set values: numbers, true/false, else strings (quotes optional)."""
+    if text in ("true", "false"):
+        return text == "true"
+    try:
+        value = float(text)
+    except ValueError:
+        return text[1:-1] if len(text) >= 2 and text[0] == text[-1] == '"' else text
+    return int(value) if value.is_integer() and "." not in text and "e" not in text.lower() else value
+
+
+def cmd_derive(args) -> int:
+    from .interpreter.derive import derive
+    from .interpreter.writers import write, write_json
+
+    if args.output in (None, "-") and args.format != "json":
+        print("bgr derive: give an output file with -o OUT.glb (or -o - --format json for the "
+              "terminal list on standard output)", file=sys.stderr)
+        return EXIT_USAGE
+    attrs = {}
+    for item in args.set:
+        name, sep, value = item.partition("=")
+        if not sep or not name.strip():
+            print(f"bgr derive: --set {item}: write NAME=VALUE", file=sys.stderr)
+            return EXIT_USAGE
+        attrs[name.strip()] = _parse_value(value.strip())
+    if args.max_depth < 1 or args.max_shapes < 1:
+        print("bgr derive: --max-depth and --max-shapes must be positive", file=sys.stderr)
+        return EXIT_USAGE
+    grammar = load(Path(args.file), path=args.file)
+    result = derive(grammar, seed=args.seed, attrs=attrs, lot=args.lot,
+                    max_depth=args.max_depth, max_shapes=args.max_shapes)
+    if args.output in (None, "-"):
+        write_json(result.terminals, sys.stdout, seed=args.seed, attrs=result.attrs)
+    else:
+        write(result.terminals, Path(args.output), seed=args.seed, attrs=result.attrs, fmt=args.format)
+        print(f"{args.output}: {len(result):,} terminals, {result.terminals.triangle_count():,} triangles",
+              file=sys.stderr)
+    return EXIT_OK
+
+
+COMMANDS = {"check": cmd_check, "fmt": cmd_fmt, "derive": cmd_derive}
 
 
 def main(argv: list[str] | None = None) -> int:

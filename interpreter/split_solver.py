@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import itertools
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any, Union
 
 EPS = 1e-9
@@ -26,7 +26,7 @@ MAX_GROUPS_EXACT = 8  # up to 2**8 extra-repetition patterns are searched exhaus
 class Piece:
     kind: str  # abs | rel | float
     size: float
-    payload: Any = None  # what the caller wants back (the entry of the syntax tree)
+    payload: Any = field(default=None, compare=False, hash=False)  # handed back: the tree's entry
 
 
 @dataclass(frozen=True)

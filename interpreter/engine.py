@@ -1,0 +1,255 @@
+"""The derivation: applying rules to shapes until only terminals are left.
+
+The loop is iterative (an explicit stack, depth first, children in order), so deep grammars
+cannot overflow Python's stack, and terminals come out in the order LANGUAGE.md section 11 fixes.
+A rule application runs its sequence of steps on one shape (:class:`Application`); operations are
+looked up by name in :mod:`bgr.interpreter.operations`, one function each.
+"""
+
+from __future__ import annotations
+
+from bgr.grammar import nodes as n
+from bgr.grammar.registry import AXES, AXIS, COMP_KIND, GEOMETRY, OPERATIONS, ROOF_KIND, SIZE
+
+from .expressions import Compiler, Context, evaluate_values, runtime_error
+from .randomness import Stream, child_hash, name_hash, root_hash
+from .shapes import Flat, Prism, Shape, Solid
+from .terminals import TerminalTable, UnitMesh
+from .geometry import meshes
+from .geometry.polygons import RECT
+
+SYMBOL_KINDS = {AXIS, AXES, COMP_KIND, ROOF_KIND, GEOMETRY}
+DEFAULT_MAX_DEPTH = 256
+DEFAULT_MAX_SHAPES = 10_000_000
+
+
+class Engine:
+    """Derives one grammar with one seed and one set of attrs; reusable for several lots."""
+
+    def __init__(self, grammar, seed: int = 0, attrs: dict | None = None,
+                 max_depth: int = DEFAULT_MAX_DEPTH, max_shapes: int = DEFAULT_MAX_SHAPES) -> None:
+        self.grammar, self.seed = grammar, seed
+        self.max_depth, self.max_shapes = max_depth, max_shapes
+        self.compilers: dict[int, Compiler] = {}
+        self.attrs = self._prepare_values(grammar, dict(attrs or {}))
+        self.table = TerminalTable()
+        self.shapes = 0
+        self._exprs: dict[int, object] = {}
+        self._flat_ids: dict[tuple, int] = {}
+        self.split_cache: dict = {}  # (block id, sizes, length) -> placed pieces
+
+    def _prepare_values(self, grammar, overrides: dict) -> dict:
+        unknown = [k for k in overrides if k not in grammar.attrs]
+        if unknown:
+            from bgr.grammar.errors import BgrError, suggest
+
+            hint = suggest(unknown[0], grammar.attrs) or ("attrs: " + ", ".join(grammar.attrs) if grammar.attrs
+                                                          else "the grammar declares no attrs")
+            raise BgrError(f"{grammar.path}: error: --set {unknown[0]}: the grammar has no attr '{unknown[0]}' ({hint})")
+        seen = set()
+
+        def prepare(g, over):
+            if id(g) in seen:
+                return
+            seen.add(id(g))
+            for sub in g.imports.values():
+                prepare(sub, {})
+            evaluate_values(g, over, self.compilers, self.seed)
+        prepare(grammar, overrides)
+        values = self.compilers[id(grammar)].values
+        return {k: values[k] for k in grammar.attrs}
+
+    # ---- expressions -------------------------------------------------------------------------
+    def compiled(self, compiler: Compiler, node, local: frozenset):
+        key = id(node)
+        fn = self._exprs.get(key)
+        if fn is None:
+            fn = self._exprs[key] = compiler.expr(node, local)
+        return fn
+
+    # ---- the loop ------------------------------------------------------------------------------
+    def derive(self, lot: Shape, rule: str | None = None, index: int = 0, several: bool = False) -> TerminalTable:
+        """Derive the start rule (or ``rule``) on a lot; ``index`` numbers lots of one run."""
+        grammar = self.grammar
+        start = rule or grammar.start
+        if start is None or start not in grammar.rules:
+            from bgr.grammar.errors import BgrError
+
+            what = f"no rule '{start}'" if start else "no rules to derive"
+            raise BgrError(f"{grammar.path}: error: the grammar has {what}")
+        lot.path = f"{start}.{index}" if several else start
+        lot.hash = child_hash(root_hash(self.seed), name_hash(start), index)
+        stack = [(lot, grammar, grammar.rules[start], {})]
+        while stack:
+            shape, module, rule_node, args = stack.pop()
+            app = Application(self, shape, module, rule_node, args)
+            app.run()
+            stack.extend(reversed(app.children))
+        return self.table
+
+    def count_shape(self, module, pos) -> None:
+        self.shapes += 1
+        if self.shapes > self.max_shapes:
+            raise runtime_error(module, pos, f"the derivation made more than {self.max_shapes:,} shapes",
+                                "a rule multiplies shapes without end? Raise the budget with --max-shapes N")
+
+    # ---- terminals -------------------------------------------------------------------------------
+    def emit(self, shape: Shape, label: str, rule: str) -> None:
+        t = self.table
+        t.label.append(shape.label or label)
+        t.rule.append(rule)
+        t.path.append(shape.path)
+        t.origin.append(shape.origin)
+        t.axes.append(shape.axes)
+        t.size.append(shape.size)
+        t.color.append(shape.color)
+        t.material.append(shape.material)
+        t.mesh.append(self.mesh_id(shape.geom))
+
+    def mesh_id(self, geom) -> int:
+        if isinstance(geom, Solid):
+            return geom.mesh
+        key = (type(geom).__name__, geom.k, geom.polys if geom.polys == RECT else id(geom))
+        found = self._flat_ids.get(key)
+        if found is not None:
+            return found
+        if isinstance(geom, Flat):
+            verts, faces = meshes.flat_mesh(geom.polys, geom.k)
+        else:
+            verts, faces = meshes.prism_mesh(geom.polys, geom.k)
+        found = self.table.library.add(UnitMesh(geom.name, verts, faces))
+        if geom.polys == RECT:
+            self._flat_ids[key] = found
+        return found
+
+    def primitive_id(self, name: str) -> int:
+        key = ("primitive", name)
+        found = self._flat_ids.get(key)
+        if found is None:
+            verts, faces = meshes.primitive(name)
+            found = self._flat_ids[key] = self.table.library.add(UnitMesh(name, verts, faces))
+        return found
+
+
+class Application:
+    """One rule applied to one shape: runs the body's steps and collects the children."""
+
+    def __init__(self, engine: Engine, shape: Shape, module, rule: n.Rule, args: dict,
+                 ctx: Context | None = None) -> None:
+        self.engine, self.shape, self.module, self.rule = engine, shape, module, rule
+        self.compiler = engine.compilers[id(module)]
+        self.local = frozenset(rule.params)
+        self.ctx = ctx or Context(shape, args, Stream(shape.hash), engine.seed)
+        self.children: list = []
+        self.counter = 0
+
+    def value(self, node):
+        return self.engine.compiled(self.compiler, node, self.local)(self.ctx)
+
+    def run(self) -> None:
+        body = self.rule.body
+        if isinstance(body, n.Sequence):
+            self.sequence(self.shape, body.steps)
+        elif isinstance(body, n.Stochastic):
+            draw = self.ctx.stream.uniform() * 100.0
+            acc = 0.0
+            for choice in body.choices:
+                if choice.prob is not None:
+                    p = self.value(choice.prob)
+                    if isinstance(p, bool) or not isinstance(p, (int, float)):
+                        raise runtime_error(self.module, choice.pos, "a percentage must be a number")
+                    acc += p
+                    if draw >= acc:
+                        continue
+                self.sequence(self.shape, choice.body.steps)
+                return
+            # no else and the draw fell past the listed percentages: the shape is deleted (NIL)
+        else:
+            for case in body.cases:
+                if case.cond is None or self.value(case.cond):
+                    self.sequence(self.shape, case.body.steps)
+                    return
+
+    def sequence(self, shape: Shape, steps) -> None:
+        """Run steps on ``shape``; a shape neither consumed nor deleted becomes a terminal."""
+        if not self.steps(shape, steps, shape.copy()):
+            self.engine.emit(shape, self.rule.name, self.rule.name)
+
+    def steps(self, shape: Shape, steps, received: Shape) -> bool:
+        """Run steps; True when the shape was consumed (by a successor, NIL, split, comp...).
+
+        ``received`` is the scope ``center()`` aligns to: the one saved by the last ``[``, or the
+        shape the rule received.  What happens inside ``[ ... ]`` works on a copy, and a copy
+        that no successor takes is dropped.
+        """
+        from .operations import IMPLEMENTATIONS
+
+        consumed = False
+        for step in steps:
+            self.ctx.shape = shape
+            if isinstance(step, n.Operation):
+                if IMPLEMENTATIONS[step.name](self, shape, step, self.arguments(step, received)):
+                    consumed = True
+            elif isinstance(step, n.Successor):
+                self.successor(shape, step)
+                consumed = True
+            elif isinstance(step, n.Nil):
+                consumed = True
+            elif isinstance(step, n.Push):
+                self.steps(shape.copy(), step.steps, shape.copy())
+        self.ctx.shape = shape
+        return consumed
+
+    def arguments(self, step: n.Operation, received: Shape) -> list:
+        """Evaluated arguments by the registry's signature: bare words stay words, a relative
+        size becomes ("rel", f), missing optional ones take their defaults; last, ``received``."""
+        spec = OPERATIONS[step.name]
+        count = len(step.args)
+        sig = next(s for s, (least, most) in zip(spec.signatures, spec.arities()) if least <= count <= most)
+        out = []
+        for i, param in enumerate(sig):
+            if i >= count:
+                out.append(param.default)
+                continue
+            arg = step.args[i]
+            if param.kind in SYMBOL_KINDS:
+                out.append(arg.name)
+            elif isinstance(arg, n.Relative):
+                out.append(("rel", self.value(arg.expr)))
+            else:
+                out.append(self.value(arg))
+        out.append(received)
+        return out
+
+    def successor(self, shape: Shape, step: n.Successor) -> None:
+        module, member = self.module.lookup_module(step.name)
+        args = [self.value(a.expr if isinstance(a, n.Relative) else a) for a in step.args]
+        child = shape.copy()
+        index = self.counter
+        self.counter += 1
+        child.path = f"{shape.path}/{member}.{index}"
+        child.hash = child_hash(shape.hash, name_hash(member), index)
+        child.depth = shape.depth + 1
+        engine = self.engine
+        engine.count_shape(self.module, step.pos)
+        if child.depth > engine.max_depth:
+            raise runtime_error(self.module, step.pos,
+                                f"the derivation is deeper than {engine.max_depth} rules (at '{step.name}')",
+                                "a rule calls itself without end? Raise the limit with --max-depth N")
+        if member in module.terminals:
+            child.label = child.label or member
+            engine.emit(child, member, member)
+            return
+        rule = module.rules[member]
+        self.children.append((child, module, rule, dict(zip(rule.params, args))))
+
+    def piece(self, shape: Shape, body: n.Sequence, split=None, comp=None) -> None:
+        """Run a block entry's steps on one piece (a split piece, a face, an inset)."""
+        ctx = self.ctx
+        saved = (ctx.split_index, ctx.split_total, ctx.comp_index, ctx.comp_total)
+        if split is not None:
+            ctx.split_index, ctx.split_total = split
+        if comp is not None:
+            ctx.comp_index, ctx.comp_total = comp
+        self.sequence(shape, body.steps)
+        ctx.split_index, ctx.split_total, ctx.comp_index, ctx.comp_total = saved

@@ -1,0 +1,20 @@
+"""One function per operation, grouped by family; IMPLEMENTATIONS maps registry names to them.
+
+Every function has the signature ``op(app, shape, step, args) -> consumed``: ``app`` is the rule
+application (for evaluating, spawning pieces and reporting errors), ``shape`` the current shape
+(changed in place), ``step`` the syntax node, ``args`` the evaluated arguments followed by the
+scope ``center()`` aligns to.  It returns True when the shape is used up (split, comp, roof...).
+"""
+
+from . import appearance, components, inserts, roofs, splits, transforms
+
+IMPLEMENTATIONS = {
+    "t": transforms.translate, "r": transforms.rotate, "s": transforms.scale,
+    "center": transforms.center, "matrix": transforms.matrix,
+    "split": splits.split,
+    "comp": components.comp, "offset": components.offset, "extrude": components.extrude,
+    "taper": components.taper,
+    "roof": roofs.roof,
+    "i": inserts.insert,
+    "color": appearance.color, "material": appearance.material, "label": appearance.label,
+}

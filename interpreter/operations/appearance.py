@@ -1,0 +1,36 @@
+"""color, material, label: what the terminals carry to the output files."""
+
+from __future__ import annotations
+
+from ..expressions import runtime_error
+
+
+def _channel(app, step, value) -> float:
+    if isinstance(value, bool) or not isinstance(value, (int, float)) or not 0.0 <= value <= 1.0:
+        raise runtime_error(app.module, step.pos, f"a colour channel must be a number in 0..1, got {value!r}")
+    return float(value)
+
+
+def color(app, shape, step, args) -> bool:
+    values = args[:-1]
+    if len(values) == 1:
+        text = values[0]
+        if not (isinstance(text, str) and len(text) == 7 and text[0] == "#"):
+            raise runtime_error(app.module, step.pos, f"{text!r} is not a colour", 'write "#rrggbb"')
+        try:
+            shape.color = tuple(int(text[i:i + 2], 16) / 255.0 for i in (1, 3, 5))
+        except ValueError:
+            raise runtime_error(app.module, step.pos, f"{text!r} is not a colour", 'write "#rrggbb"') from None
+    else:
+        shape.color = tuple(_channel(app, step, v) for v in values)
+    return False
+
+
+def material(app, shape, step, args) -> bool:
+    shape.material = str(args[0])
+    return False
+
+
+def label(app, shape, step, args) -> bool:
+    shape.label = str(args[0])
+    return False

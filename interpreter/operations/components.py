@@ -1,0 +1,207 @@
+"""comp(f), offset, extrude, taper: between 2D and 3D shapes (LANGUAGE.md sections 5 and 7)."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from bgr.grammar import nodes as n
+
+from ..expressions import runtime_error
+from ..geometry.meshes import PLANE_AXES
+from ..geometry.polygons import RECT, UNIT_SQUARE, inset, is_unit_square, normalise as normalise_polys, signed_area
+from ..shapes import Flat, Prism, Solid, cross, dot, normalise
+from ..terminals import UnitMesh
+
+
+# ---- comp(f) -----------------------------------------------------------------------------------
+
+def _faces(app, step, shape):
+    """Faces of a shape as (points in scope-local metres, outward normal in scope coordinates)."""
+    geom = shape.geom
+    if isinstance(geom, Solid) and geom.name == "cube":
+        geom = Prism(1, RECT)
+    if isinstance(geom, Solid):
+        raise runtime_error(app.module, step.pos, f"comp(f) of a '{geom.name}' shape is not supported",
+                            "comp(f) works on extruded shapes, boxes and 2D shapes")
+    size = shape.size
+    k = geom.k
+    p, q = PLANE_AXES[k]
+    polys = [(UNIT_SQUARE, ())] if geom.polys == RECT else geom.polys
+
+    def point(u, v, h):
+        vec = [0.0, 0.0, 0.0]
+        vec[p], vec[q], vec[k] = u * size[p], v * size[q], h * size[k]
+        return vec
+
+    up = [0.0, 0.0, 0.0]
+    up[k] = 1.0
+    if isinstance(geom, Flat):
+        return [([[point(u, v, 0) for u, v in ext], *[[point(u, v, 0) for u, v in h] for h in holes]], up)
+                for ext, holes in polys]
+    faces = []
+    for ext, holes in polys:
+        for ring, is_hole in [(ext, False)] + [(h, True) for h in holes]:
+            ccw = signed_area([(u * size[p], v * size[q]) for u, v in ring]) > 0
+            outward_right = ccw != is_hole
+            for (u0, v0), (u1, v1) in zip(ring, ring[1:] + ring[:1]):
+                a, b = point(u0, v0, 0), point(u1, v1, 0)
+                edge = [b[i] - a[i] for i in range(3)]
+                nrm = normalise(cross(edge, up) if outward_right else cross(up, edge))
+                if dot(edge, edge) < 1e-18:
+                    continue
+                faces.append(([[a, b, point(u1, v1, 1), point(u0, v0, 1)]], nrm))
+    down = [-c for c in up]
+    for ext, holes in polys:
+        faces.append(([[point(u, v, 1) for u, v in ext], *[[point(u, v, 1) for u, v in h] for h in holes]], up))
+    for ext, holes in polys:
+        faces.append(([[point(u, v, 0) for u, v in ext], *[[point(u, v, 0) for u, v in h] for h in holes]], down))
+    return faces
+
+
+def _classify(nrm) -> str:
+    """top, bottom, front, back, left or right, by the outward normal in the shape's scope."""
+    x, y, z = nrm
+    if abs(y) > 0.7071:
+        return "top" if y > 0 else "bottom"
+    if abs(x) >= abs(z):
+        return "right" if x > 0 else "left"
+    return "back" if z > 0 else "front"
+
+
+def _face_shape(shape, rings, nrm):
+    """The 2D shape of a face: x along its bottom edge, y up the face, z out (section 7)."""
+    z = nrm
+    if abs(z[1]) > 0.7071:  # horizontal: x follows the scope's x
+        ref = [1.0, 0.0, 0.0] if abs(z[0]) < 0.9 else [0.0, 0.0, 1.0]
+        x = normalise([ref[i] - dot(ref, z) * z[i] for i in range(3)])
+        y = cross(z, x)
+    else:
+        ref = [0.0, 1.0, 0.0]
+        y = normalise([ref[i] - dot(ref, z) * z[i] for i in range(3)])
+        x = cross(y, z)
+    coords = [[(dot(pt, x), dot(pt, y)) for pt in ring] for ring in rings]
+    xs = [c[0] for ring in coords for c in ring]
+    ys = [c[1] for ring in coords for c in ring]
+    x0, y0 = min(xs), min(ys)
+    w, h = max(xs) - x0, max(ys) - y0
+    plane = dot(rings[0][0], z)
+    origin_local = [x0 * x[i] + y0 * y[i] + plane * z[i] for i in range(3)]
+    unit = [tuple(((cx - x0) / (w or 1.0), (cy - y0) / (h or 1.0)) for cx, cy in ring) for ring in coords]
+    polys = [(unit[0], tuple(unit[1:]))]
+    face = shape.copy()
+    face.origin = shape.world(origin_local)
+    face.axes = (tuple(shape.direction(x)), tuple(shape.direction(y)), tuple(shape.direction(z)))
+    face.size = [w, h, 0.0]
+    face.geom = Flat(2, RECT if is_unit_square(polys) else polys)
+    return face
+
+
+def _matches(app, key, kind: str, index: int) -> bool:
+    if isinstance(key, n.Call):  # face(i)
+        return int(app.value(key.args[0])) == index
+    name = key.name
+    return name == "all" or name == kind or (name == "side" and kind not in ("top", "bottom"))
+
+
+def comp(app, shape, step, args) -> bool:
+    faces = _faces(app, step, shape)
+    kinds = [_classify(nrm) for _, nrm in faces]
+    taken = [False] * len(faces)
+    for entry in step.block.entries:
+        chosen = [i for i in range(len(faces)) if not taken[i] and _matches(app, entry.key, kinds[i], i)]
+        for i in chosen:
+            taken[i] = True
+        for j, i in enumerate(chosen):
+            rings, nrm = faces[i]
+            face = _face_shape(shape, rings, nrm)
+            app.engine.count_shape(app.module, entry.pos)
+            app.piece(face, entry.body, comp=(j, len(chosen)))
+    return True
+
+
+# ---- offset ------------------------------------------------------------------------------------
+
+def offset(app, shape, step, args) -> bool:
+    distance = args[0]
+    geom = shape.geom
+    if not isinstance(geom, Flat):
+        raise runtime_error(app.module, step.pos, "offset() needs a 2D shape", "use it on a face from comp(f)")
+    p, q = PLANE_AXES[geom.k]
+    polys = [(UNIT_SQUARE, ())] if geom.polys == RECT else geom.polys
+    inside, border = inset(polys, shape.size[p], shape.size[q], float(distance))
+    parts = {"inside": inside, "border": border}
+    for entry in step.block.entries:
+        metric_polys = parts[entry.key.name]
+        if not metric_polys:
+            continue
+        unit, (x0, y0, w, h) = normalise_polys(metric_polys)
+        piece = shape.copy()
+        move = [0.0, 0.0, 0.0]
+        move[p], move[q] = x0, y0
+        piece.origin = shape.world(move)
+        piece.size[p], piece.size[q] = w, h
+        piece.geom = Flat(geom.k, RECT if is_unit_square(unit) else unit)
+        app.engine.count_shape(app.module, entry.pos)
+        app.piece(piece, entry.body)
+    return True
+
+
+# ---- extrude and taper -------------------------------------------------------------------------
+
+def _flat(app, step, shape) -> Flat:
+    if not isinstance(shape.geom, Flat):
+        raise runtime_error(app.module, step.pos, f"{step.name}() needs a 2D shape, and this one is already 3D",
+                            "extrude a lot or a face (from comp(f)), not a mass")
+    return shape.geom
+
+
+def _height(app, step, value) -> float:
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        raise runtime_error(app.module, step.pos, f"{step.name}() needs a number, got {value!r}")
+    if value < 0:
+        raise runtime_error(app.module, step.pos, f"negative height {value:g} in {step.name}()",
+                            "heights are lengths; use r() to turn a shape over")
+    return float(value)
+
+
+def extrude(app, shape, step, args) -> bool:
+    geom = _flat(app, step, shape)
+    shape.size[geom.k] = _height(app, step, args[0])
+    shape.geom = Prism(geom.k, geom.polys)
+    return False
+
+
+def taper(app, shape, step, args) -> bool:
+    geom = _flat(app, step, shape)
+    height, ratio = _height(app, step, args[0]), args[1]
+    if isinstance(ratio, bool) or not isinstance(ratio, (int, float)) or ratio < 0:
+        raise runtime_error(app.module, step.pos, f"taper() needs a ratio >= 0, got {ratio!r}")
+    from ..geometry.meshes import _lift, _orient
+    from ..geometry.polygons import triangulate
+
+    polys = [(UNIT_SQUARE, ())] if geom.polys == RECT else geom.polys
+    pts2, tris = triangulate(polys)
+    centre = pts2.mean(axis=0)
+    top2 = centre + (pts2 - centre) * ratio
+    k = geom.k
+    bottom, top = _lift(pts2, k, 0.0), _lift(top2, k, 1.0)
+    up = np.eye(3)[k]
+    verts = [bottom, top]
+    faces = [_orient(bottom, tris, lambda c: np.broadcast_to(-up, c.shape))]
+    if ratio > 0:
+        faces.append(_orient(top, tris, lambda c: np.broadcast_to(up, c.shape)) + len(bottom))
+    base, middle = len(bottom) + len(top), np.array([*centre, 0.5])
+    for ext, holes in polys:
+        for ring in [ext, *holes]:
+            for a, b in zip(ring, ring[1:] + ring[:1]):
+                quad2 = np.array([a, b, b, a], dtype=float)
+                lifted = np.vstack([_lift(quad2[:2], k, 0.0), _lift(centre + (quad2[2:] - centre) * ratio, k, 1.0)])
+                mid3 = _lift(middle[None, :2], k, 0.5)[0]
+                quad_faces = _orient(lifted, np.array([[0, 1, 2], [0, 2, 3]]), lambda c: c - mid3)
+                verts.append(lifted)
+                faces.append(quad_faces + base)
+                base += 4
+    mesh = UnitMesh("taper", np.vstack(verts), np.vstack(faces))
+    shape.size[k] = height
+    shape.geom = Solid(app.engine.table.library.add(mesh), "taper")
+    return False

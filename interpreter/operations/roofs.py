@@ -1,0 +1,52 @@
+"""roof(kind, pitch, overhang): a roof mesh on a 2D footprint, from the geometry package."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..expressions import runtime_error
+from ..geometry.meshes import PLANE_AXES
+from ..geometry.polygons import RECT, UNIT_SQUARE, metric
+from ..shapes import Flat, Solid
+from ..terminals import UnitMesh
+
+
+def roof(app, shape, step, args) -> bool:
+    kind, pitch, overhang = args[0], args[1], args[2]
+    geom = shape.geom
+    if not isinstance(geom, Flat):
+        raise runtime_error(app.module, step.pos, "roof() needs a 2D footprint",
+                            "use it on a lot or on the top face from comp(f)")
+    for what, value in (("pitch", pitch), ("overhang", overhang)):
+        if isinstance(value, bool) or not isinstance(value, (int, float)):
+            raise runtime_error(app.module, step.pos, f"the roof's {what} must be a number, got {value!r}")
+    if kind != "flat" and not 0 < pitch < 90:
+        raise runtime_error(app.module, step.pos, f"a roof pitch must lie between 0 and 90 degrees, got {pitch:g}")
+    if overhang < 0:
+        raise runtime_error(app.module, step.pos, f"a negative overhang ({overhang:g}) is not a roof")
+    from ..geometry.roofs import roof_mesh
+
+    k = geom.k
+    p, q = PLANE_AXES[k]
+    polys = [(UNIT_SQUARE, ())] if geom.polys == RECT else geom.polys
+    verts, faces = [], []
+    base = 0
+    for ext, _holes in metric(polys, shape.size[p], shape.size[q]):
+        m = roof_mesh(np.asarray(ext, dtype=float), kind, float(pitch), float(overhang))
+        verts.append(m.vertices)
+        faces.append(m.faces + base)
+        base += len(m.vertices)
+    local = np.vstack(verts)
+    tris = np.vstack(faces)
+    # face-local (plane p, plane q, up) -> scope axes; an odd permutation flips the winding
+    scoped = np.zeros_like(local)
+    scoped[:, p], scoped[:, q], scoped[:, k] = local[:, 0], local[:, 1], local[:, 2]
+    if (p, q, k) in ((0, 2, 1), (2, 1, 0), (1, 0, 2)):
+        tris = tris[:, ::-1]
+    lo, hi = scoped.min(axis=0), scoped.max(axis=0)
+    extent = hi - lo
+    unit = (scoped - lo) / np.where(extent > 0, extent, 1.0)
+    shape.origin = shape.world(lo.tolist())
+    shape.size = extent.tolist()
+    shape.geom = Solid(app.engine.table.library.add(UnitMesh("roof", unit, tris)), "roof")
+    return False

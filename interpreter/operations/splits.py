@@ -1,0 +1,82 @@
+"""split(axis) { ... }: cut the scope into pieces (LANGUAGE.md section 6).
+
+The sizes are evaluated per shape; the placement comes from :mod:`bgr.interpreter.split_solver`,
+memoised on (block, sizes, length) because a façade's floors and tiles repeat the same lengths
+thousands of times.  Each piece's geometry is the part of the shape's geometry inside it.
+"""
+
+from __future__ import annotations
+
+import math
+
+from bgr.grammar import nodes as n
+
+from ..expressions import runtime_error
+from ..geometry.meshes import PLANE_AXES
+from ..geometry.polygons import RECT, clip, renormalise
+from ..shapes import Flat, Prism, Solid
+from ..split_solver import Piece, Repeat, solve
+
+def _items(app, entries) -> tuple:
+    out = []
+    for entry in entries:
+        if isinstance(entry, n.Group):
+            out.append(Repeat(_items(app, entry.entries)))
+            continue
+        size = app.value(entry.key)
+        if isinstance(size, bool) or not isinstance(size, (int, float)) or not math.isfinite(size):
+            raise runtime_error(app.module, entry.pos, f"a split size must be a finite number, got {size!r}")
+        out.append(Piece(entry.kind, float(size), entry))
+    return tuple(out)
+
+
+def _clip(app, step, geom, axis: int, lo: float, hi: float):
+    """The piece of a geometry between unit coordinates lo and hi along ``axis``; None if empty."""
+    if isinstance(geom, Solid):
+        if geom.name == "cube":
+            return geom
+        raise runtime_error(app.module, step.pos, f"split of a '{geom.name}' shape is not supported",
+                            "split the footprint or the faces (comp(f)) instead of the solid")
+    if axis == geom.k:
+        return geom if isinstance(geom, Prism) else None
+    if geom.polys == RECT:
+        return geom
+    which = PLANE_AXES[geom.k].index(axis)
+    polys = renormalise(clip(geom.polys, which, lo, hi), which, lo, hi)
+    if not polys:
+        return None
+    return type(geom)(geom.k, polys, geom.name)
+
+
+def split(app, shape, step, args) -> bool:
+    axis = "xyz".index(args[0])
+    length = shape.size[axis]
+    items = _items(app, step.block.entries)
+    if step.block.repeat:
+        items = (Repeat(items),)
+    key = (id(step.block), items, length)
+    cache = app.engine.split_cache
+    placed = cache.get(key)
+    if placed is None:
+        placed = solve(items, length)
+        if len(cache) > 100_000:
+            cache.clear()
+        cache[key] = placed
+    pieces = []
+    for p in placed:
+        lo, hi = (p.offset / length, (p.offset + p.size) / length) if length > 0 else (0.0, 0.0)
+        geom = _clip(app, step, shape.geom, axis, lo, hi)
+        if geom is None:
+            continue
+        piece = shape.copy()
+        move = [0.0, 0.0, 0.0]
+        move[axis] = p.offset
+        piece.origin = shape.world(move)
+        piece.size[axis] = p.size
+        piece.geom = geom
+        pieces.append((piece, p.payload))
+    total = len(pieces)
+    for index, (piece, entry) in enumerate(pieces):
+        app.engine.count_shape(app.module, entry.pos)
+        app.piece(piece, entry.body, split=(index, total))
+    return True

@@ -1,0 +1,92 @@
+"""t, r, s, center, matrix: changes of the scope.  Geometry is in unit scope coordinates, so it
+follows the scope without being touched."""
+
+from __future__ import annotations
+
+import math
+
+from ..expressions import runtime_error
+from ..shapes import cross, dot, normalise
+
+
+def _amounts(app, step, shape, values) -> list[float]:
+    out = []
+    for i, v in enumerate(values):
+        rel = isinstance(v, tuple)
+        v = v[1] if rel else v
+        if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v):
+            raise runtime_error(app.module, step.pos, f"'{step.name}' needs numbers, got {v!r}")
+        out.append(v * shape.size[i] if rel else float(v))
+    return out
+
+
+def translate(app, shape, step, args) -> bool:
+    d = _amounts(app, step, shape, args[:3])
+    shape.origin = shape.world(d)
+    return False
+
+
+def scale(app, shape, step, args) -> bool:
+    size = _amounts(app, step, shape, args[:3])
+    if min(size) < 0:
+        raise runtime_error(app.module, step.pos, f"negative size {min(size):g} in s()",
+                            "sizes are lengths; flip a shape with r() instead")
+    shape.size = size
+    return False
+
+
+def _rotate_axes(axes, axis: int, degrees: float):
+    """Intrinsic rotation about the scope's own axis ``axis``."""
+    a = math.radians(degrees)
+    c, s = math.cos(a), math.sin(a)
+    i, j = [(1, 2), (2, 0), (0, 1)][axis]
+    u, v = axes[i], axes[j]
+    new = list(axes)
+    new[i] = tuple(c * u[k] + s * v[k] for k in range(3))
+    new[j] = tuple(-s * u[k] + c * v[k] for k in range(3))
+    return tuple(new)
+
+
+def rotate(app, shape, step, args) -> bool:
+    angles = _amounts(app, step, shape, args[:3])
+    axes = shape.axes
+    for axis, deg in enumerate(angles):
+        if deg:
+            axes = _rotate_axes(axes, axis, deg)
+    shape.axes = axes
+    return False
+
+
+def center(app, shape, step, args) -> bool:
+    which, received = args[0], args[-1]
+    # the centre of the received scope, in this scope's frame
+    target = received.world([received.size[i] / 2 for i in range(3)])
+    mine = shape.world([shape.size[i] / 2 for i in range(3)])
+    delta = [target[i] - mine[i] for i in range(3)]
+    move = [0.0, 0.0, 0.0]
+    for axis in which:
+        k = "xyz".index(axis)
+        move[k] = dot(delta, shape.axes[k])
+    shape.origin = shape.world(move)
+    return False
+
+
+def matrix(app, shape, step, args) -> bool:
+    """A 3x4 affine map in the scope's frame.  Its linear part is split into an orthonormal frame
+    and scale factors (Gram-Schmidt); a shear, which a scope cannot hold, is dropped."""
+    m = _amounts(app, step, shape, [v for v in args[:-1]])
+    cols = [[m[r * 4 + c] for r in range(3)] for c in range(3)]
+    offset = [m[3], m[7], m[11]]
+    lengths = [dot(col, col) ** 0.5 for col in cols]
+    if min(lengths) < 1e-12:
+        raise runtime_error(app.module, step.pos, "matrix() flattens the scope (a zero column)")
+    x = normalise(cols[0])
+    y = normalise([cols[1][k] - dot(cols[1], x) * x[k] for k in range(3)])
+    z = cross(x, y)
+    if dot(z, cols[2]) < 0:
+        raise runtime_error(app.module, step.pos, "matrix() mirrors the scope; scopes stay right-handed")
+    new_origin = shape.world(offset)
+    shape.axes = tuple(tuple(shape.direction(v)) for v in (x, y, z))
+    shape.origin = new_origin
+    shape.size = [shape.size[i] * lengths[i] for i in range(3)]
+    return False

@@ -1,0 +1,92 @@
+"""Shapes: a scope (origin, three orthonormal axes, size) plus geometry and appearance.
+
+Scopes use plain Python floats: a shape's 3-vectors are too small for numpy to pay off, and the
+derivation creates hundreds of thousands of them.  Geometry lives in unit scope coordinates, so
+``s()`` rescales a shape without touching its geometry.
+
+Geometry kinds (LANGUAGE.md sections 4-5):
+
+* :class:`Flat` — a 2D shape: polygons in the plane of two scope axes, flat along axis ``k``
+  (a lot: k = 1, y; a face from ``comp``: k = 2, z).
+* :class:`Prism` — the base polygons extruded from 0 to 1 along axis ``k``.
+* :class:`Solid` — any other mesh (primitives, roofs, assets, tapers), by unit-mesh id.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+Vec = tuple[float, float, float]
+IDENTITY: tuple[Vec, Vec, Vec] = ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0))
+
+
+@dataclass(frozen=True, slots=True)
+class Flat:
+    k: int
+    polys: object  # polygons.RECT or a list of (exterior, holes) in unit coordinates
+    name: str = "polygon"
+
+
+@dataclass(frozen=True, slots=True)
+class Prism:
+    k: int
+    polys: object
+    name: str = "prism"
+
+
+@dataclass(frozen=True, slots=True)
+class Solid:
+    mesh: int  # id in the derivation's MeshLibrary
+    name: str  # what the terminal list's "geometry" says: cube, roof, an asset's name...
+
+
+class Shape:
+    """One shape of the derivation.  Copied, never shared, between parent and children."""
+
+    __slots__ = ("origin", "axes", "size", "geom", "color", "material", "label",
+                 "path", "hash", "depth")
+
+    def __init__(self, origin, axes, size, geom, color=(0.8, 0.8, 0.8), material=None, label=None,
+                 path="", hash_=0, depth=0) -> None:
+        self.origin: list[float] = list(origin)
+        self.axes: tuple[Vec, Vec, Vec] = axes
+        self.size: list[float] = list(size)
+        self.geom = geom
+        self.color = color
+        self.material = material
+        self.label = label
+        self.path = path
+        self.hash = hash_
+        self.depth = depth
+
+    def copy(self) -> "Shape":
+        return Shape(self.origin, self.axes, self.size, self.geom, self.color, self.material,
+                     self.label, self.path, self.hash, self.depth)
+
+    @property
+    def local_origin(self) -> list[float]:
+        return self.origin
+
+    def world(self, local: Vec) -> list[float]:
+        """A point in scope-local metres -> world."""
+        o, (ax, ay, az) = self.origin, self.axes
+        x, y, z = local
+        return [o[i] + x * ax[i] + y * ay[i] + z * az[i] for i in range(3)]
+
+    def direction(self, local: Vec) -> list[float]:
+        (ax, ay, az) = self.axes
+        x, y, z = local
+        return [x * ax[i] + y * ay[i] + z * az[i] for i in range(3)]
+
+
+def cross(a, b) -> list[float]:
+    return [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
+
+
+def dot(a, b) -> float:
+    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+
+
+def normalise(a) -> list[float]:
+    length = dot(a, a) ** 0.5
+    return [a[0] / length, a[1] / length, a[2] / length] if length > 1e-15 else [0.0, 0.0, 0.0]
