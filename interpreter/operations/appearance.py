@@ -11,14 +11,20 @@ def _channel(app, step, value) -> float:
     return float(value)
 
 
+_PARSED: dict[str, tuple] = {}
+
+
 def color(app, shape, step, args) -> bool:
     values = args[:-1]
     if len(values) == 1:
         text = values[0]
+        if text in _PARSED:
+            shape.color = _PARSED[text]
+            return False
         if not (isinstance(text, str) and len(text) == 7 and text[0] == "#"):
             raise runtime_error(app.module, step.pos, f"{text!r} is not a colour", 'write "#rrggbb"')
         try:
-            shape.color = tuple(int(text[i:i + 2], 16) / 255.0 for i in (1, 3, 5))
+            shape.color = _PARSED[text] = tuple(int(text[i:i + 2], 16) / 255.0 for i in (1, 3, 5))
         except ValueError:
             raise runtime_error(app.module, step.pos, f"{text!r} is not a colour", 'write "#rrggbb"') from None
     else:
