@@ -70,8 +70,10 @@ def parse_lot_option(value: str) -> list[Lot]:
 def read_geojson(path: Path) -> list[Lot]:
     """Every Polygon / MultiPolygon feature becomes a lot (its exterior ring).
 
-    Longitude/latitude (any coordinate within +-180, +-90) are projected to metres around the
-    collection's centre; other coordinates are taken as metres.  East is +x, north is -z.
+    Longitude/latitude (every coordinate within +-180, +-90 and the whole set within one degree)
+    are projected to metres around the collection's centre (equirectangular, good to a few
+    centimetres over a city district); other coordinates are taken as metres.  East is +x,
+    north is -z.
     """
     shown = str(path)
     try:
@@ -104,7 +106,9 @@ def read_geojson(path: Path) -> list[Lot]:
         flat = [(float(c[0]), float(c[1])) for ring, _, _ in rings for c in ring]
     except (TypeError, ValueError, IndexError):
         raise BgrError(Diagnostic(shown, 0, 0, "coordinates must be [x, y] numbers")) from None
-    geographic = all(abs(x) <= 180 and abs(y) <= 90 for x, y in flat)
+    xs, ys = [x for x, _ in flat], [y for _, y in flat]
+    geographic = (all(abs(x) <= 180 and abs(y) <= 90 for x, y in flat)
+                  and max(xs) - min(xs) < 1.0 and max(ys) - min(ys) < 1.0)
     lon0 = sum(x for x, _ in flat) / len(flat)
     lat0 = sum(y for _, y in flat) / len(flat)
     kx, ky = (111_320.0 * math.cos(math.radians(lat0)), 110_540.0) if geographic else (1.0, 1.0)

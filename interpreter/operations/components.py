@@ -42,7 +42,8 @@ def _faces(app, step, shape):
     for ext, holes in polys:
         for ring, is_hole in [(ext, False)] + [(h, True) for h in holes]:
             ccw = signed_area([(u * size[p], v * size[q]) for u, v in ring]) > 0
-            outward_right = ccw != is_hole
+            # (p, q, k) is a left-handed order for k = y (x, z, y): there the sides swap
+            outward_right = (ccw != is_hole) != (k == 1)
             for (u0, v0), (u1, v1) in zip(ring, ring[1:] + ring[:1]):
                 a, b = point(u0, v0, 0), point(u1, v1, 0)
                 edge = [b[i] - a[i] for i in range(3)]
