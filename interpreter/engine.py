@@ -91,13 +91,13 @@ class Engine:
             raise BgrError(f"{grammar.path}: error: the grammar has {what}")
         lot.path = f"{start}.{index}" if several else start
         lot.hash = child_hash(root_hash(self.seed), name_hash(start), index)
-        stack = [(lot, grammar, grammar.rules[start], {})]
+        stack = [(lot, grammar, grammar.rules[start], {}, (0, 1, 0, 1))]
         gc_was_on = gc.isenabled()
         gc.disable()  # hundreds of thousands of short-lived shapes and no cycles: measured 15% faster
         try:
             while stack:
-                shape, module, rule_node, args = stack.pop()
-                app = Application(self, shape, module, rule_node, args)
+                shape, module, rule_node, args, indices = stack.pop()
+                app = Application(self, shape, module, rule_node, args, indices)
                 app.run()
                 stack.extend(reversed(app.children))
         finally:
@@ -153,11 +153,12 @@ class Application:
     """One rule applied to one shape: runs the body's steps and collects the children."""
 
     def __init__(self, engine: Engine, shape: Shape, module, rule: n.Rule, args: dict,
-                 ctx: Context | None = None) -> None:
+                 indices=(0, 1, 0, 1)) -> None:
         self.engine, self.shape, self.module, self.rule = engine, shape, module, rule
         self.compiler = engine.compilers[id(module)]
         self.local = frozenset(rule.params)
-        self.ctx = ctx or Context(shape, args, Stream(shape.hash), engine.seed)
+        # split.index/total and comp.index/total of the piece this shape came from stay visible
+        self.ctx = Context(shape, args, Stream(shape.hash), engine.seed, indices[:2], indices[2:])
         self.children: list = []
         self.counter = 0
 
@@ -261,7 +262,9 @@ class Application:
             engine.emit(child, member, member)
             return
         rule = module.rules[member]
-        self.children.append((child, module, rule, dict(zip(rule.params, args))))
+        ctx = self.ctx
+        self.children.append((child, module, rule, dict(zip(rule.params, args)),
+                              (ctx.split_index, ctx.split_total, ctx.comp_index, ctx.comp_total)))
 
     def piece(self, shape: Shape, body: n.Sequence, split=None, comp=None) -> None:
         """Run a block entry's steps on one piece (a split piece, a face, an inset)."""
