@@ -1,0 +1,105 @@
+"""Benchmark: write a ~1M-triangle terminal table as .glb, with and without instancing.
+
+    python bench/writers.py [--triangles 1000000] [--repeat 5] [--out DIR]
+
+The table holds N boxes (12 triangles, one shared unit mesh, 4 colours, random rotations about y)
+and N quads that each have their own unit mesh (like polygons and roof faces), with N chosen so
+that 14 N reaches the requested triangle count.  Boxes are instanced (EXT_mesh_gpu_instancing);
+quads are baked.  Prints the median and best wall time of ``write`` (building the buffer and
+writing the file) and the file sizes.  Target (issue): 1M triangles in about 0.2 s.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import platform
+import statistics
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+
+from bgr.interpreter.terminals import TerminalTable, UnitMesh
+from bgr.interpreter.writers import write
+from bgr.interpreter.writers.glb import write_glb
+
+BOX_V = np.array([[x, y, z] for x in (0, 1) for y in (0, 1) for z in (0, 1)], dtype=float)
+BOX_F = np.array([[0, 1, 3], [0, 3, 2], [4, 6, 7], [4, 7, 5], [0, 4, 5], [0, 5, 1],
+                  [2, 3, 7], [2, 7, 6], [0, 2, 6], [0, 6, 4], [1, 5, 7], [1, 7, 3]])
+QUAD_F = np.array([[0, 1, 2], [0, 2, 3]])
+
+
+def table(n: int, seed: int = 0) -> TerminalTable:
+    rng = np.random.default_rng(seed)
+    t = TerminalTable()
+    box = t.library.add(UnitMesh("cube", BOX_V, BOX_F))
+    angle = rng.uniform(0, 2 * np.pi, n)
+    c, s = np.cos(angle), np.sin(angle)
+    z, o = np.zeros(n), np.ones(n)
+    rot = np.stack([np.stack([c, z, -s], 1), np.stack([z, o, z], 1), np.stack([s, z, c], 1)], 1)
+    palette = np.array([[0.8, 0.3, 0.2], [0.9, 0.9, 0.85], [0.2, 0.3, 0.4], [0.5, 0.5, 0.5]])
+    # quads: each its own unit mesh (a random convex quadrilateral in the unit square)
+    jitter = rng.uniform(0, 0.2, (n, 4, 2))
+    corners = np.array([[0, 0], [1, 0], [1, 1], [0, 1]], dtype=float)
+    quad_v = np.zeros((n, 4, 3))
+    quad_v[:, :, :2] = np.abs(corners - jitter)
+    quads = [t.library.add(UnitMesh("polygon", quad_v[i], QUAD_F), key=("q", i)) for i in range(n)]
+
+    t.label = ["Box"] * n + ["Quad"] * n
+    t.rule = list(t.label)
+    t.path = [f"Lot/Box.{i}" for i in range(n)] + [f"Lot/Quad.{i}" for i in range(n)]
+    t.origin = np.concatenate([rng.uniform(0, 1000, (n, 3)), rng.uniform(0, 1000, (n, 3))])
+    t.axes = np.concatenate([rot, np.broadcast_to(np.eye(3), (n, 3, 3))])
+    t.size = np.concatenate([rng.uniform(1, 20, (n, 3)), np.column_stack([rng.uniform(1, 5, (n, 2)), z])])
+    t.color = np.concatenate([palette[rng.integers(0, 4, n)], palette[rng.integers(0, 4, n)]])
+    t.material = [None] * (2 * n)
+    t.mesh = [box] * n + quads
+    return t.freeze()
+
+
+def timed(fn, repeat: int) -> tuple[float, float]:
+    runs = []
+    for _ in range(repeat):
+        start = time.perf_counter()
+        fn()
+        runs.append(time.perf_counter() - start)
+    return statistics.median(runs), min(runs)
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--triangles", type=int, default=1_000_000)
+    ap.add_argument("--repeat", type=int, default=5)
+    ap.add_argument("--out", type=Path, default=None, help="folder for the files (default: a temp dir)")
+    args = ap.parse_args()
+    n = max(1, args.triangles // 14)
+    start = time.perf_counter()
+    t = table(n)
+    print(f"table: {len(t):,} terminals, {t.triangle_count():,} triangles "
+          f"(built in {time.perf_counter() - start:.2f} s)")
+    print(f"python {platform.python_version()}, numpy {np.__version__}, {platform.machine()}, "
+          f"{os.cpu_count()} cpus")
+    with tempfile.TemporaryDirectory(dir=args.out) as tmp:
+        for label, instancing in [("instanced (auto)", "auto"), ("no instancing", False)]:
+            path = Path(tmp) / f"bench_{instancing}.glb"
+
+            def run():
+                if instancing == "auto":
+                    write(t, path, seed=0, attrs={})
+                else:  # the same atomic path, with instancing off
+                    with open(path, "wb") as f:
+                        write_glb(t, f, seed=0, attrs={}, instancing=False)
+
+            median, best = timed(run, args.repeat)
+            print(f"glb {label:17s}: median {median:.3f} s, best {best:.3f} s, "
+                  f"{path.stat().st_size / 1e6:.1f} MB")
+        for ext in ["json", "ply", "stl", "obj"]:
+            path = Path(tmp) / f"bench.{ext}"
+            median, best = timed(lambda: write(t, path, seed=0, attrs={}), 1)
+            print(f"{ext:21s}: {median:.3f} s, {path.stat().st_size / 1e6:.1f} MB")
+
+
+if __name__ == "__main__":
+    main()

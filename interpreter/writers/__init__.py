@@ -1,0 +1,94 @@
+"""Output files from a terminal table (LANGUAGE.md section 11).
+
+    from bgr.interpreter.writers import write, write_json, to_trimesh
+    write(table, Path("out.glb"), seed=3, attrs={"height": 18})     # format from the extension
+    write(table, Path("-"), seed=3, attrs={}, fmt="json")            # the terminal list on stdout
+
+Every file is written atomically (:mod:`.atomic`): a failure leaves no output and no temporary
+file behind.  Failures a user can act on (unknown format, unwritable folder) are ``BgrError``.
+"""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+
+from ...grammar.errors import BgrError, Diagnostic
+from ..terminals import TerminalTable
+from .atomic import atomic_files
+from .glb import write_glb, write_gltf
+from .glb_read import read_glb
+from .meshes import bake, to_trimesh
+from .obj import write_obj
+from .ply import write_ply
+from .stl import write_stl
+from .terminal_json import write_json, write_json_bytes
+
+# format name -> writer(table, binary stream, *, seed, attrs); obj is special (two files)
+FORMATS = {
+    "glb": write_glb,
+    "gltf": write_gltf,
+    "obj": write_obj,
+    "ply": write_ply,
+    "stl": write_stl,
+    "json": write_json_bytes,
+}
+EXTENSIONS = {f".{name}": name for name in FORMATS}
+NOT_YET = {".city.json": "CityJSON output is not implemented yet"}
+
+__all__ = ["write", "write_json", "to_trimesh", "read_glb", "bake", "format_of", "FORMATS",
+           "EXTENSIONS"]
+
+
+def _known() -> str:
+    return "known extensions: " + ", ".join(EXTENSIONS)
+
+
+def format_of(path: Path, fmt: str | None = None) -> str:
+    """The format name for an output path (or the explicit ``fmt``); BgrError when unknown."""
+    if fmt is not None:
+        name = fmt.lower().lstrip(".")
+        if name not in FORMATS:
+            raise BgrError(f"unknown output format '{fmt}'; known formats: {', '.join(FORMATS)}")
+        return name
+    lower = str(path).lower()
+    for ext, why in NOT_YET.items():
+        if lower.endswith(ext):
+            raise BgrError(Diagnostic(str(path), 0, 0, why, _known()))
+    suffix = Path(lower).suffix
+    if suffix not in EXTENSIONS:
+        shown = f"unknown output extension '{suffix}'" if suffix else "the output file name has no extension"
+        raise BgrError(Diagnostic(str(path), 0, 0, shown, _known()))
+    return EXTENSIONS[suffix]
+
+
+def write(table: TerminalTable, path: Path, *, seed: int, attrs: dict, fmt: str | None = None) -> None:
+    """Write ``table`` to ``path`` in the format of its extension, or ``fmt`` when given.
+
+    ``path`` ``"-"`` writes to standard output and needs ``fmt`` (not ``obj``, which is two files).
+    For ``.obj`` the ``.mtl`` is written beside it, with the same stem.
+    """
+    table.freeze()
+    path = Path(path)
+    if str(path) == "-":
+        if fmt is None:
+            raise BgrError("writing to standard output ('-') needs a format, e.g. --format json")
+        name = format_of(path, fmt)
+        if name == "json":
+            write_json(table, sys.stdout, seed=seed, attrs=attrs)
+        elif name == "obj":
+            raise BgrError("obj cannot go to standard output (it comes with a .mtl file); give a file name")
+        else:
+            sys.stdout.flush()
+            FORMATS[name](table, sys.stdout.buffer, seed=seed, attrs=attrs)
+            sys.stdout.buffer.flush()
+        return
+
+    name = format_of(path, fmt)
+    if name == "obj":
+        mtl = path.with_suffix(".mtl")
+        with atomic_files([path, mtl]) as (f_obj, f_mtl):
+            write_obj(table, f_obj, f_mtl, mtl_name=mtl.name, seed=seed, attrs=attrs)
+    else:
+        with atomic_files([path]) as (f,):
+            FORMATS[name](table, f, seed=seed, attrs=attrs)

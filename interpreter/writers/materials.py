@@ -1,0 +1,63 @@
+"""Materials of an output file: one per distinct (colour, material name) pair, in first-use order.
+
+Colours are compared as the ``#rrggbb`` the terminal list writes, so two terminals that print the
+same colour share a material.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..terminals import TerminalTable
+from .meshes import srgb8
+
+
+@dataclass
+class Materials:
+    index: np.ndarray  # (N,) material of each terminal
+    rgb8: np.ndarray  # (K, 3) uint8 sRGB
+    names: list[str | None]  # (K,) the material() name, or None
+    labels: list[str]  # (K,) a display name, unique: the material name, else the colour hex
+
+    def __len__(self) -> int:
+        return len(self.names)
+
+    def hex(self, k: int) -> str:
+        return "#%02x%02x%02x" % tuple(int(c) for c in self.rgb8[k])
+
+    def linear(self, k: int) -> list[float]:
+        """The colour in linear light (glTF's baseColorFactor), from its sRGB bytes."""
+        c = self.rgb8[k].astype(np.float64) / 255.0
+        lin = np.where(c <= 0.04045, c / 12.92, ((c + 0.055) / 1.055) ** 2.4)
+        return [round(float(v), 6) for v in lin]
+
+
+def materials_of(table: TerminalTable) -> Materials:
+    table.freeze()
+    rgb = srgb8(table)
+    packed = (rgb[:, 0].astype(np.int64) << 16) | (rgb[:, 1].astype(np.int64) << 8) | rgb[:, 2]
+    name_ids = {name: i for i, name in enumerate(dict.fromkeys(table.material))}
+    if len(name_ids) <= 1:
+        names_col = np.zeros(len(table), dtype=np.int64)
+    else:
+        names_col = np.fromiter(map(name_ids.__getitem__, table.material), dtype=np.int64, count=len(table))
+    key = (names_col << 24) | packed
+    uniq, first, inverse = np.unique(key, return_index=True, return_inverse=True)
+    order = np.argsort(first, kind="stable")  # materials in order of first use
+    rank = np.empty_like(order)
+    rank[order] = np.arange(len(order))
+    index = rank[inverse.reshape(-1)]
+    id_names = {i: n for n, i in name_ids.items()}
+    names = [id_names[int(uniq[k] >> 24)] for k in order]
+    rgb8 = rgb[first[order]] if len(order) else np.zeros((0, 3), dtype=np.uint8)
+
+    labels: list[str] = []
+    colours_per_name: dict[str | None, int] = {}
+    for n in names:
+        colours_per_name[n] = colours_per_name.get(n, 0) + 1
+    for k, n in enumerate(names):
+        hx = "#%02x%02x%02x" % tuple(int(c) for c in rgb8[k])
+        labels.append(hx if n is None else (n if colours_per_name[n] == 1 else f"{n} {hx}"))
+    return Materials(index=index.astype(np.int64), rgb8=rgb8, names=names, labels=labels)

@@ -1,0 +1,18 @@
+"""Binary .stl: triangles only (STL has no colours or materials)."""
+
+from __future__ import annotations
+
+from typing import BinaryIO
+
+import trimesh
+from trimesh.exchange.stl import export_stl
+
+from ..terminals import TerminalTable
+from .meshes import bake
+
+
+def write_stl(table: TerminalTable, stream: BinaryIO, *, seed: int, attrs: dict) -> None:
+    table.freeze()
+    baked = bake(table)
+    mesh = trimesh.Trimesh(baked.vertices, baked.faces, process=False)
+    stream.write(export_stl(mesh))

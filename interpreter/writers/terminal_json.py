@@ -1,0 +1,101 @@
+"""The terminal list (LANGUAGE.md section 11): what exact tests read.
+
+One terminal per line, keys in the order the language reference shows, floats as Python's ``repr``
+(shortest text that reads back to the same double), so a round trip through ``json.loads`` is exact.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import gc
+import json
+from typing import BinaryIO, TextIO
+
+import numpy as np
+
+from ...grammar.errors import BgrError
+from ..terminals import TerminalTable
+from .meshes import srgb8
+
+
+def plain(value):
+    """json's fallback for numpy values (and tuples) in attrs."""
+    if isinstance(value, np.generic):
+        return value.item()
+    if isinstance(value, np.ndarray):
+        return value.tolist()
+    if isinstance(value, (tuple, set, frozenset)):
+        return list(value)
+    raise TypeError(f"{type(value).__name__} is not JSON data")
+
+
+_ENCODER = json.JSONEncoder(ensure_ascii=False, allow_nan=False, default=plain)
+
+
+def _dumps(value) -> str:
+    try:
+        return _ENCODER.encode(value)
+    except (TypeError, ValueError) as exc:
+        raise BgrError(f"cannot write the terminal list as JSON: {exc}") from exc
+
+
+@contextlib.contextmanager
+def _no_gc():
+    """Pause the cyclic collector: it would rescan millions of fresh small lists again and again."""
+    was_on = gc.isenabled()
+    gc.disable()
+    try:
+        yield
+    finally:
+        if was_on:
+            gc.enable()
+
+
+def terminal_dicts(table: TerminalTable) -> list[dict]:
+    """The ``terminals`` array as Python data, in table order."""
+    table.freeze()
+    with _no_gc():
+        # adding 0.0 turns -0.0 into 0.0: same value, tidier text
+        origin = (table.origin + 0.0).tolist()
+        axes = (table.axes + 0.0).tolist()
+        size = (table.size + 0.0).tolist()
+        rgb = srgb8(table).astype(np.int64)  # rounded as terminals.color_hex rounds
+        colours = [f"#{v:06x}" for v in ((rgb[:, 0] << 16) | (rgb[:, 1] << 8) | rgb[:, 2]).tolist()]
+        return [
+            {
+                "label": label,
+                "rule": rule,
+                "path": path,
+                "origin": o,
+                "axes": a,
+                "size": sz,
+                "color": c,
+                "material": material,
+                "geometry": geometry,
+            }
+            for label, rule, path, o, a, sz, c, material, geometry in zip(
+                table.label, table.rule, table.path, origin, axes, size, colours, table.material,
+                table.geometry_names())
+        ]
+
+
+def dumps(table: TerminalTable, *, seed: int, attrs: dict) -> str:
+    """The whole document as text (ends with a newline)."""
+    with _no_gc():
+        return _document(table, seed, attrs)
+
+
+def _document(table: TerminalTable, seed: int, attrs: dict) -> str:
+    head = f'{{\n  "bgr": 1,\n  "seed": {_dumps(seed)},\n  "attrs": {_dumps(attrs)},\n  "terminals": ['
+    rows = ",\n".join(["    " + _dumps(t) for t in terminal_dicts(table)])
+    return head + ("\n" + rows + "\n  ]\n}\n" if rows else "]\n}\n")
+
+
+def write_json(table: TerminalTable, stream: TextIO, *, seed: int, attrs: dict) -> None:
+    """Write the terminal list to a text stream (``sys.stdout`` for ``-o -``)."""
+    stream.write(dumps(table, seed=seed, attrs=attrs))
+
+
+def write_json_bytes(table: TerminalTable, stream: BinaryIO, *, seed: int, attrs: dict) -> None:
+    """Write the terminal list, UTF-8 encoded, to a binary stream."""
+    stream.write(dumps(table, seed=seed, attrs=attrs).encode("utf-8"))
