@@ -24,7 +24,7 @@ class Diagnostic:
 
     def render(self) -> str:
         where = f"{self.path}:{self.line}:{self.column}" if self.line else self.path
-        out = [f"{where}: error: {self.message}"]
+        out = [f"{where}: error: {self.message}" if where else f"error: {self.message}"]
         if self.source_line is not None and self.line:
             text = self.source_line.rstrip("\r\n")
             gutter = f"{self.line:>5} | "
@@ -41,7 +41,7 @@ class Diagnostic:
 class BgrError(Exception):
     """The one exception type users of bgr see: bad input, with where and why."""
 
-    def __init__(self, diagnostics: Diagnostic | Iterable[Diagnostic] | str, path: str = "<text>"):
+    def __init__(self, diagnostics: Diagnostic | Iterable[Diagnostic] | str, path: str = ""):
         if isinstance(diagnostics, str):
             diagnostics = [Diagnostic(path, 0, 0, diagnostics)]
         elif isinstance(diagnostics, Diagnostic):

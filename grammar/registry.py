@@ -98,7 +98,7 @@ OPERATIONS: dict[str, Op] = {
            "comp(f) { top: Roof | side: Facade }", block="comp"),
         Op("offset", "components", _sig(Param("distance", NUMBER)),
            "Inset a 2D face by a distance (a negative one grows it) into an inside and a border.",
-           "offset(-0.2) { inside: Glass | border: Frame }", block="offset"),
+           "offset(0.2) { inside: Glass | border: Frame }", block="offset"),
         Op("extrude", "components", _sig(Param("height", NUMBER)),
            "Turn a 2D shape into a prism of the given height along its normal.",
            "extrude(12)"),

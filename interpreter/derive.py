@@ -63,7 +63,7 @@ def derive(grammar: Grammar | str | os.PathLike, seed: int = 0, attrs: dict | No
         overrides = dict(attrs)
         overrides.update({k: v for k, v in each.properties.items() if k in grammar.attrs
                           and isinstance(v, (int, float, str, bool)) and v is not None})
-        engine = Engine(grammar, seed, overrides, max_depth, max_shapes)
+        engine = Engine(grammar, seed, overrides, max_depth, max_shapes, lot_index=i)
         engine.table = table
         engine.split_cache = shared_cache
         shape = each.shape.copy()

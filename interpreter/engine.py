@@ -13,6 +13,8 @@ import gc
 from bgr.grammar import nodes as n
 from bgr.grammar.registry import AXES, AXIS, COMP_KIND, GEOMETRY, OPERATIONS, ROOF_KIND, SIZE
 
+from bgr.grammar.errors import BgrError, Diagnostic, suggest
+
 from .expressions import Compiler, Context, evaluate_values, runtime_error
 from .randomness import Stream, child_hash, name_hash, root_hash
 from .shapes import Flat, Prism, Shape, Solid
@@ -22,7 +24,7 @@ from .geometry.polygons import RECT
 from .operations import IMPLEMENTATIONS
 
 SYMBOL_KINDS = {AXIS, AXES, COMP_KIND, ROOF_KIND, GEOMETRY}
-_SIGNATURES: dict[int, tuple] = {}  # id(operation node) -> its signature; nodes live with the grammar
+EMIT = object()  # marks a children-list entry that is a finished terminal, kept in order
 _NAME_HASHES: dict[str, int] = {}
 
 
@@ -39,8 +41,9 @@ class Engine:
     """Derives one grammar with one seed and one set of attrs; reusable for several lots."""
 
     def __init__(self, grammar, seed: int = 0, attrs: dict | None = None,
-                 max_depth: int = DEFAULT_MAX_DEPTH, max_shapes: int = DEFAULT_MAX_SHAPES) -> None:
-        self.grammar, self.seed = grammar, seed
+                 max_depth: int = DEFAULT_MAX_DEPTH, max_shapes: int = DEFAULT_MAX_SHAPES,
+                 lot_index: int = 0) -> None:
+        self.grammar, self.seed, self.lot_index = grammar, seed, lot_index
         self.max_depth, self.max_shapes = max_depth, max_shapes
         self.compilers: dict[int, Compiler] = {}
         self.attrs = self._prepare_values(grammar, dict(attrs or {}))
@@ -49,15 +52,14 @@ class Engine:
         self._exprs: dict[int, object] = {}
         self._flat_ids: dict[tuple, int] = {}
         self.split_cache: dict = {}  # (block id, sizes, length) -> placed pieces
+        self.signatures: dict[int, tuple] = {}  # id(operation node) -> its signature (the grammar outlives us)
 
     def _prepare_values(self, grammar, overrides: dict) -> dict:
         unknown = [k for k in overrides if k not in grammar.attrs]
         if unknown:
-            from bgr.grammar.errors import BgrError, suggest
-
             hint = suggest(unknown[0], grammar.attrs) or ("attrs: " + ", ".join(grammar.attrs) if grammar.attrs
                                                           else "the grammar declares no attrs")
-            raise BgrError(f"{grammar.path}: error: --set {unknown[0]}: the grammar has no attr '{unknown[0]}' ({hint})")
+            raise BgrError(Diagnostic(grammar.path, 0, 0, f"the grammar has no attr '{unknown[0]}' to set", hint))
         seen = set()
 
         def prepare(g, over):
@@ -66,7 +68,7 @@ class Engine:
             seen.add(id(g))
             for sub in g.imports.values():
                 prepare(sub, {})
-            evaluate_values(g, over, self.compilers, self.seed)
+            evaluate_values(g, over, self.compilers, self.seed, self.lot_index)
         prepare(grammar, overrides)
         values = self.compilers[id(grammar)].values
         return {k: values[k] for k in grammar.attrs}
@@ -85,10 +87,12 @@ class Engine:
         grammar = self.grammar
         start = rule or grammar.start
         if start is None or start not in grammar.rules:
-            from bgr.grammar.errors import BgrError
-
             what = f"no rule '{start}'" if start else "no rules to derive"
-            raise BgrError(f"{grammar.path}: error: the grammar has {what}")
+            raise BgrError(Diagnostic(grammar.path, 0, 0, f"the grammar has {what}"))
+        if grammar.rules[start].params:
+            raise runtime_error(grammar, grammar.rules[start].pos,
+                                f"the start rule '{start}' takes parameters, but the lot comes with none",
+                                "start from a rule without parameters that calls this one")
         lot.path = f"{start}.{index}" if several else start
         lot.hash = child_hash(root_hash(self.seed), name_hash(start), index)
         stack = [(lot, grammar, grammar.rules[start], {}, (0, 1, 0, 1))]
@@ -96,7 +100,11 @@ class Engine:
         gc.disable()  # hundreds of thousands of short-lived shapes and no cycles: measured 15% faster
         try:
             while stack:
-                shape, module, rule_node, args, indices = stack.pop()
+                item = stack.pop()
+                if item[0] is EMIT:
+                    self.emit(*item[1:])
+                    continue
+                shape, module, rule_node, args, indices = item
                 app = Application(self, shape, module, rule_node, args, indices)
                 app.run()
                 stack.extend(reversed(app.children))
@@ -172,17 +180,22 @@ class Application:
         elif isinstance(body, n.Stochastic):
             draw = self.ctx.stream.uniform() * 100.0
             acc = 0.0
-            for choice in body.choices:
-                if choice.prob is not None:
-                    p = self.value(choice.prob)
-                    if isinstance(p, bool) or not isinstance(p, (int, float)):
-                        raise runtime_error(self.module, choice.pos, "a percentage must be a number")
-                    acc += p
-                    if draw >= acc:
-                        continue
-                self.sequence(self.shape, choice.body.steps)
-                return
-            # no else and the draw fell past the listed percentages: the shape is deleted (NIL)
+            chosen = None
+            for choice in body.choices:  # every percentage is checked, whichever branch is taken
+                if choice.prob is None:
+                    chosen = chosen or choice
+                    continue
+                p = self.value(choice.prob)
+                if isinstance(p, bool) or not isinstance(p, (int, float)) or p < 0:
+                    raise runtime_error(self.module, choice.pos,
+                                        f"a percentage must be a number from 0 to 100, got {p!r}")
+                acc += p
+                if acc > 100 + 1e-9:
+                    raise runtime_error(self.module, choice.pos, f"the percentages add up to {acc:g}%, over 100%")
+                if chosen is None and draw < acc:
+                    chosen = choice
+            if chosen is not None:  # no else and a draw past the percentages: deleted, as NIL
+                self.sequence(self.shape, chosen.body.steps)
         else:
             for case in body.cases:
                 if case.cond is None or self.value(case.cond):
@@ -190,9 +203,11 @@ class Application:
                     return
 
     def sequence(self, shape: Shape, steps) -> None:
-        """Run steps on ``shape``; a shape neither consumed nor deleted becomes a terminal."""
-        if not self.steps(shape, steps, shape.copy()):
-            self.engine.emit(shape, self.rule.name, self.rule.name)
+        """Run steps on ``shape``; a shape that no successor took and nothing consumed or deleted
+        becomes a terminal, in its place among the children (depth first, children in order)."""
+        spawned = self.counter
+        if not self.steps(shape, steps, shape.copy()) and self.counter == spawned:
+            self.children.append((EMIT, shape, self.rule.name, self.rule.name))
 
     def steps(self, shape: Shape, steps, received: Shape) -> bool:
         """Run steps; True when the shape was consumed (by a successor, NIL, split, comp...).
@@ -221,10 +236,11 @@ class Application:
     def arguments(self, step: n.Operation, received: Shape) -> list:
         """Evaluated arguments by the registry's signature: bare words stay words, a relative
         size becomes ("rel", f), missing optional ones take their defaults; last, ``received``."""
-        sig = _SIGNATURES.get(id(step))
+        signatures = self.engine.signatures
+        sig = signatures.get(id(step))
         if sig is None:
             spec, count = OPERATIONS[step.name], len(step.args)
-            sig = _SIGNATURES[id(step)] = next(
+            sig = signatures[id(step)] = next(
                 s for s, (least, most) in zip(spec.signatures, spec.arities()) if least <= count <= most)
         count = len(step.args)
         out = []
@@ -259,7 +275,7 @@ class Application:
                                 "a rule calls itself without end? Raise the limit with --max-depth N")
         if member in module.terminals:
             child.label = child.label or member
-            engine.emit(child, member, member)
+            self.children.append((EMIT, child, member, member))
             return
         rule = module.rules[member]
         ctx = self.ctx

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import math
 import operator
+from pathlib import Path
 from typing import Any, Callable
 
 from bgr.grammar import nodes as n
@@ -234,17 +235,17 @@ class Compiler:
 
 
 def evaluate_values(grammar, overrides: dict[str, Value], modules: dict[int, Compiler],
-                    seed: int = 0) -> dict[str, Value]:
+                    seed: int = 0, lot_index: int = 0) -> dict[str, Value]:
     """Evaluate a module's attrs and consts in dependency order (attrs may be overridden).
 
-    rand() in an attr draws from a stream of the seed and the module's path, once per derivation.
+    rand() in an attr draws from a stream of the seed, the lot and the attr's own name: each lot
+    of a GeoJSON gets its own draw, and the draw does not depend on how a path was spelt.
     """
     values: dict[str, Value] = {}
     compiler = Compiler(grammar, values, modules)
     modules[id(grammar)] = compiler
     pending = {**grammar.attrs, **grammar.consts}
-    stream = Stream(child_hash(root_hash(seed), name_hash(grammar.path), 0))
-    ctx = Context(None, {}, stream, seed)
+    ctx = Context(None, {}, None, seed)
 
     def get(name):
         if name in values:
@@ -256,7 +257,13 @@ def evaluate_values(grammar, overrides: dict[str, Value], modules: dict[int, Com
             for dep in _deps(item.value):
                 if dep in pending:
                     get(dep)
-            values[name] = compiler.expr(item.value)(ctx)
+            ctx.stream = Stream(child_hash(root_hash(seed), name_hash(Path(grammar.path).stem + "." + name), lot_index))
+            try:
+                values[name] = compiler.expr(item.value)(ctx)
+            except AttributeError:  # a func that reads the shape, called where there is none
+                raise runtime_error(grammar, item.pos, f"'{name}' reads the shape (scope.*, depth) through a "
+                                    "function, but attrs and consts are evaluated before any shape exists",
+                                    "compute it in a rule instead") from None
         return values[name]
 
     for name in pending:

@@ -44,7 +44,7 @@ class Shape:
     """One shape of the derivation.  Copied, never shared, between parent and children."""
 
     __slots__ = ("origin", "axes", "size", "geom", "color", "material", "label",
-                 "path", "hash", "depth")
+                 "path", "hash", "depth", "frame")
 
     def __init__(self, origin, axes, size, geom, color=(0.8, 0.8, 0.8), material=None, label=None,
                  path="", hash_=0, depth=0) -> None:
@@ -58,14 +58,27 @@ class Shape:
         self.path = path
         self.hash = hash_
         self.depth = depth
+        self.frame = None  # (origin, axes) of the shape this one was cut from; None: the world
 
     def copy(self) -> "Shape":
-        return Shape(self.origin, self.axes, self.size, self.geom, self.color, self.material,
+        twin = Shape(self.origin, self.axes, self.size, self.geom, self.color, self.material,
                      self.label, self.path, self.hash, self.depth)
+        twin.frame = self.frame
+        return twin
+
+    def cut_from(self, parent: "Shape") -> "Shape":
+        """Mark this shape as a piece of ``parent`` (a split piece, a face, an inset)."""
+        self.frame = (tuple(parent.origin), parent.axes)
+        return self
 
     @property
     def local_origin(self) -> list[float]:
-        return self.origin
+        """scope.x/y/z: the origin in the frame of the shape this one was cut from."""
+        if self.frame is None:
+            return self.origin
+        (ox, oy, oz), axes = self.frame
+        d = (self.origin[0] - ox, self.origin[1] - oy, self.origin[2] - oz)
+        return [d[0] * a[0] + d[1] * a[1] + d[2] * a[2] for a in axes]
 
     def world(self, local: Vec) -> list[float]:
         """A point in scope-local metres -> world."""

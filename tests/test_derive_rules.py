@@ -58,7 +58,7 @@ def test_attrs_consts_funcs_params_and_set():
 
 
 def test_unknown_attr_in_set_is_an_error():
-    with pytest.raises(bgr.BgrError, match="no attr 'hieght'.*did you mean 'height'"):
+    with pytest.raises(bgr.BgrError, match="(?s)no attr 'hieght'.*did you mean 'height'"):
         bgr.derive(bgr.load("attr height = 1\nLot --> NIL\n"), attrs={"hieght": 3})
 
 
@@ -125,3 +125,32 @@ def test_missing_asset_is_reported_at_its_declaration(tmp_path):
 def test_terminal_paths_follow_the_derivation():
     t = bgr.derive(bgr.load("Lot --> extrude(3) comp(f) { top: Roof | side: Wall }\nterminal Roof, Wall\n")).terminals
     assert t.path[0] == "Lot/Roof.0" and t.path[1] == "Lot/Wall.1"
+
+
+def test_scope_origin_is_read_in_the_frame_of_the_shape_it_was_cut_from():
+    src = "Lot --> split(x) { { 2: P }* }\nP --> s(scope.x + 1, '1, '1) X\nterminal X\n"
+    t = bgr.derive(bgr.load(src), lot=(6, 1)).terminals
+    assert [s[0] for s in t.size] == [1, 3, 5]
+
+
+def test_terminals_come_depth_first_in_child_order():
+    src = "Lot --> [ t(1, 0, 0) A ] T\nA --> X Y\nterminal T, X, Y\n"
+    assert bgr.derive(bgr.load(src)).terminals.label == ["X", "Y", "T"]
+
+
+def test_a_rule_that_only_places_children_in_brackets_is_no_terminal():
+    src = "Cluster --> [ t(0, 0, 0) Tower ] [ t(12, 0, 0) r(0, 90, 0) Tower ]\nterminal Tower\n"
+    assert bgr.derive(bgr.load(src)).terminals.label == ["Tower", "Tower"]
+
+
+def test_computed_percentages_are_checked_when_they_run():
+    with pytest.raises(bgr.BgrError, match="over 100%"):
+        bgr.derive(bgr.load("attr p = 70\nLot --> (p)%: A | (p)%: A\nterminal A\n"), seed=5)
+
+
+def test_rand_in_an_attr_is_drawn_per_lot_and_not_per_path_spelling(tmp_path):
+    f = tmp_path / "r.bgr"
+    f.write_text("attr h = rand(1, 100)\nLot --> s('1, h, '1) X\nterminal X\n")
+    a = bgr.derive(bgr.load(f), seed=2).terminals.size[0][1]
+    b = bgr.derive(bgr.load(str(tmp_path / "." / "r.bgr")), seed=2).terminals.size[0][1]
+    assert a == b

@@ -89,7 +89,7 @@ def _face_shape(shape, rings, nrm):
     origin_local = [x0 * x[i] + y0 * y[i] + plane * z[i] for i in range(3)]
     unit = [tuple(((cx - x0) / (w or 1.0), (cy - y0) / (h or 1.0)) for cx, cy in ring) for ring in coords]
     polys = [(unit[0], tuple(unit[1:]))]
-    face = shape.copy()
+    face = shape.copy().cut_from(shape)
     face.origin = shape.world(origin_local)
     face.axes = (tuple(shape.direction(x)), tuple(shape.direction(y)), tuple(shape.direction(z)))
     face.size = [w, h, 0.0]
@@ -136,7 +136,7 @@ def offset(app, shape, step, args) -> bool:
         if not metric_polys:
             continue
         unit, (x0, y0, w, h) = normalise_polys(metric_polys)
-        piece = shape.copy()
+        piece = shape.copy().cut_from(shape)
         move = [0.0, 0.0, 0.0]
         move[p], move[q] = x0, y0
         piece.origin = shape.world(move)

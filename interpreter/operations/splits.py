@@ -68,7 +68,7 @@ def split(app, shape, step, args) -> bool:
         geom = _clip(app, step, shape.geom, axis, lo, hi)
         if geom is None:
             continue
-        piece = shape.copy()
+        piece = shape.copy().cut_from(shape)
         move = [0.0, 0.0, 0.0]
         move[axis] = p.offset
         piece.origin = shape.world(move)
