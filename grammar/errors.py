@@ -80,6 +80,12 @@ def suggest(name: str, known: Iterable[str]) -> str | None:
     return f"did you mean '{close[0]}'?" if close else None
 
 
+def source_lines(source: str) -> list[str]:
+    """Lines as the lexer counts them: only "\n" ends a line (str.splitlines also breaks at
+    "\r", "\f", "\u2028" ... which would put messages and comments on the wrong line)."""
+    return [line[:-1] if line.endswith("\r") else line for line in source.split("\n")]
+
+
 def source_line(source: str, line: int) -> str | None:
-    lines = source.splitlines()
+    lines = source_lines(source)
     return lines[line - 1] if 0 < line <= len(lines) else None

@@ -21,6 +21,7 @@ import math
 from dataclasses import dataclass
 
 from . import nodes as n
+from .errors import BgrError, Diagnostic, source_lines
 
 WIDTH = 100
 INDENT = "    "
@@ -43,6 +44,8 @@ def format_number(value: float) -> str:
 
 
 def format_string(value: str) -> str:
+    if "\x00" in value:
+        raise ValueError("a .bgr string cannot hold a NUL character")
     escaped = value.replace("\\", "\\\\").replace('"', '\\"').replace("\n", "\\n").replace("\t", "\\t")
     return f'"{escaped}"'
 
@@ -54,8 +57,8 @@ def _level(e) -> int:
         return _UNARY_LEVEL[e.op]
     if isinstance(e, n.Ternary):
         return 0
-    if isinstance(e, n.Number) and (e.value < 0 or (e.value == 0 and math.copysign(1, e.value) < 0)):
-        return _UNARY_LEVEL["-"]  # -2 prints like a prefix minus
+    if isinstance(e, n.Number) and e.value < 0:
+        return _UNARY_LEVEL["-"]  # -2 prints like a prefix minus (and -0.0 prints as 0)
     return _ATOM
 
 
@@ -156,7 +159,7 @@ class Formatter:
         self.width = width
         self.comments = sorted(module.comments, key=lambda c: (c.line, c.column))
         self.comment_keys = [(c.line, c.column) for c in self.comments]
-        self.source_lines = module.source.splitlines() if module.source else []
+        self.source_lines = source_lines(module.source) if module.source else []
 
     # ---- comments inside a span decide between one line and several -------------------
     def has_comment_inside(self, pos: n.Pos) -> bool:
@@ -164,6 +167,10 @@ class Formatter:
             return False
         i = bisect.bisect_left(self.comment_keys, (pos.line, 0))
         return i < len(self.comment_keys) and self.comment_keys[i] < (pos.end_line, pos.end_column)
+
+    def has_comment_on_line(self, line: int) -> bool:
+        i = bisect.bisect_left(self.comment_keys, (line, 0))
+        return i < len(self.comment_keys) and self.comment_keys[i][0] == line
 
     def can_inline(self, node) -> bool:
         if self.has_comment_inside(node.pos):
@@ -212,8 +219,11 @@ class Formatter:
         alts = body.choices if isinstance(body, n.Stochastic) else body.cases
         heads = [self.alt_head(a) for a in alts]
         inline = head + " " + " | ".join(h + self.inline_steps(a.body.steps) for h, a in zip(heads, alts))
+        # Branches have no closing bracket, so a comment after the last one also keeps them
+        # one per line once they already start below the head (that is how fmt wrote them).
+        trailing_below = body.pos.line > rule.pos.line and self.has_comment_on_line(body.pos.end_line)
         if all(self.can_inline(a.body) for a in alts) and not self.has_comment_inside(body.pos) \
-                and len(inline) <= self.width:
+                and not trailing_below and len(inline) <= self.width:
             out.write(inline)
             return
         out.write(head)
@@ -350,7 +360,11 @@ def _blocks_in(node):
 
 def format_module(module: n.Module, width: int = WIDTH) -> str:
     """Canonical text of a syntax tree (parsed, or built by an inverse module)."""
-    return Formatter(module, width).format()
+    try:
+        return Formatter(module, width).format()
+    except RecursionError:
+        raise BgrError(Diagnostic(module.path, 0, 0, "the grammar nests expressions or blocks too deeply "
+                                  "to format", "split deep nesting into separate rules")) from None
 
 
 def format_source(text: str, path: str = "<text>") -> str:

@@ -17,7 +17,7 @@ from lark import Lark, Token, Transformer
 from lark.exceptions import UnexpectedCharacters, UnexpectedEOF, UnexpectedInput, UnexpectedToken
 
 from . import nodes as n
-from .errors import BgrSyntaxError, Diagnostic, source_line, suggest
+from .errors import BgrSyntaxError, Diagnostic, source_line, source_lines, suggest
 from .registry import KEYWORDS, OPERATIONS
 
 GRAMMAR_FILE = Path(__file__).with_name("bgr.lark")
@@ -363,6 +363,9 @@ def parse(text: str, path: str = "<text>") -> n.Module:
         _comments.tokens = []
         try:
             items = _lark().parse(text)
+        except RecursionError:
+            raise BgrSyntaxError(Diagnostic(path, 0, 0, "the file nests expressions or blocks too deeply",
+                                            "split deep nesting into separate rules")) from None
         except _Problem as p:
             raise BgrSyntaxError(Diagnostic(path, p.pos.line, p.pos.column, p.message, p.hint,
                                             source_line(text, p.pos.line), p.length)) from None
@@ -371,7 +374,7 @@ def parse(text: str, path: str = "<text>") -> n.Module:
         tokens = _comments.tokens
         _comments.tokens = []
     comments = []
-    lines = text.splitlines()
+    lines = source_lines(text)
     for tok in tokens:
         before = lines[tok.line - 1][: tok.column - 1] if tok.line <= len(lines) else ""
         comments.append(n.Comment(str(tok).rstrip(), tok.line, tok.column, not before.strip()))
@@ -470,7 +473,9 @@ def _translate(e: UnexpectedInput, text: str, path: str) -> BgrSyntaxError:
     if special is not None:
         return special
     if isinstance(e, UnexpectedEOF) or (tok is not None and tok.type == "$END"):
-        lines = text.splitlines() or [""]
+        lines = source_lines(text) or [""]
+        while len(lines) > 1 and not lines[-1].strip():
+            lines.pop()
         line, column = len(lines), len(lines[-1]) + 1
         tok = Token("$END", "")
     words = _describe_expected(expected)
