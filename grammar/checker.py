@@ -482,7 +482,7 @@ class Checker:
     def value_cycles(self) -> None:
         """attr a = b + 1; attr b = a: report a definition cycle among attrs and consts."""
         values = {**self.g.attrs, **self.g.consts}
-        deps = {name: {x.name for x in _names(item.value) if x.name in values} for name, item in values.items()}
+        deps = {name: {x.name for x in n.names_in(item.value) if x.name in values} for name, item in values.items()}
         state: dict[str, int] = {}
         for root in deps:
             if state.get(root):
@@ -506,22 +506,6 @@ class Checker:
                     state[child] = 1
                     stack.append((child, iter(sorted(deps[child]))))
                     path.append(child)
-
-
-def _names(e):
-    stack = [e]
-    while stack:
-        e = stack.pop()
-        if isinstance(e, n.Name):
-            yield e
-        elif isinstance(e, n.Binary):
-            stack += (e.left, e.right)
-        elif isinstance(e, n.Unary):
-            stack.append(e.operand)
-        elif isinstance(e, n.Ternary):
-            stack += (e.cond, e.then, e.otherwise)
-        elif isinstance(e, n.Call):
-            stack += e.args
 
 
 def _article(what: str) -> str:

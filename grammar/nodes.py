@@ -9,7 +9,7 @@ directly and print them with :mod:`bgr.grammar.formatter`.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Union
+from typing import Iterator, Union
 
 
 @dataclass(frozen=True)
@@ -307,3 +307,22 @@ class Module:
 
     def rules(self) -> list[Rule]:
         return [item for item in self.items if isinstance(item, Rule)]
+
+
+def names_in(expr) -> "Iterator[Name]":
+    """Every Name inside an expression, without recursion (operator chains can be long)."""
+    stack = [expr]
+    while stack:
+        e = stack.pop()
+        if isinstance(e, Name):
+            yield e
+        elif isinstance(e, Binary):
+            stack += (e.left, e.right)
+        elif isinstance(e, Unary):
+            stack.append(e.operand)
+        elif isinstance(e, Ternary):
+            stack += (e.cond, e.then, e.otherwise)
+        elif isinstance(e, Call):
+            stack += e.args
+        elif isinstance(e, Relative):
+            stack.append(e.expr)

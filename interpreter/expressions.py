@@ -254,9 +254,9 @@ def evaluate_values(grammar, overrides: dict[str, Value], modules: dict[int, Com
             values[name] = overrides[name]
         else:
             item = pending[name]
-            for dep in _deps(item.value):
-                if dep in pending:
-                    get(dep)
+            for dep in n.names_in(item.value):
+                if dep.name in pending:
+                    get(dep.name)
             ctx.stream = Stream(child_hash(root_hash(seed), name_hash(Path(grammar.path).stem + "." + name), lot_index))
             try:
                 values[name] = compiler.expr(item.value)(ctx)
@@ -269,19 +269,3 @@ def evaluate_values(grammar, overrides: dict[str, Value], modules: dict[int, Com
     for name in pending:
         get(name)
     return values
-
-
-def _deps(e):
-    stack = [e]
-    while stack:
-        e = stack.pop()
-        if isinstance(e, n.Name):
-            yield e.name
-        elif isinstance(e, n.Binary):
-            stack += (e.left, e.right)
-        elif isinstance(e, n.Unary):
-            stack.append(e.operand)
-        elif isinstance(e, n.Ternary):
-            stack += (e.cond, e.then, e.otherwise)
-        elif isinstance(e, n.Call):
-            stack += e.args

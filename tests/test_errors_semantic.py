@@ -15,27 +15,7 @@ import sys
 import pytest
 
 import bgr
-
-
-def first_error(src) -> bgr.BgrError:
-    with pytest.raises(bgr.BgrError) as e:
-        bgr.load(src)
-    return e.value
-
-
-def check(src, line: int, column: int, message: str, hint: str | None = None) -> bgr.BgrError:
-    err = first_error(src)
-    assert (err.line, err.column) == (line, column), err.render()
-    assert message in err.message, err.render()
-    if hint is not None:
-        assert err.hint is not None and hint in err.hint, err.render()
-    first = err.diagnostics[0]
-    assert (first.line, first.column, first.message) == (err.line, err.column, err.message)
-    return err
-
-
-def bug(reason: str):
-    return pytest.mark.xfail(reason=reason, strict=True)
+from errors_helpers import bug, check, first_error
 
 
 # (source, line, column, message substring, hint substring or None)

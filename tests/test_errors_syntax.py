@@ -10,32 +10,11 @@ from __future__ import annotations
 import pytest
 
 import bgr
+from errors_helpers import bug, check, first_error
 
 # Words that must never reach a user: Lark's terminal names and Python internals.
 LARK_WORDS = ("__ANON", "LPAR", "RPAR", "LBRACE", "RBRACE", "LSQB", "RSQB", "$END", "RULE_NAME",
               "PERCENT", "COLON", "Token(", "Traceback", "lark")
-
-
-def first_error(src) -> bgr.BgrError:
-    with pytest.raises(bgr.BgrError) as e:
-        bgr.load(src)
-    return e.value
-
-
-def check(src, line: int, column: int, message: str, hint: str | None = None) -> bgr.BgrError:
-    err = first_error(src)
-    assert (err.line, err.column) == (line, column), err.render()
-    assert message in err.message, err.render()
-    if hint is not None:
-        assert err.hint is not None and hint in err.hint, err.render()
-    # the error's own fields are those of its first diagnostic
-    first = err.diagnostics[0]
-    assert (first.line, first.column, first.message) == (err.line, err.column, err.message)
-    return err
-
-
-def bug(reason: str):
-    return pytest.mark.xfail(reason=reason, strict=True)
 
 
 # (source, line, column, message substring, hint substring or None)

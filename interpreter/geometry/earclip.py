@@ -48,6 +48,7 @@ def triangulate(points: np.ndarray) -> np.ndarray:
     a, b, c = pts[idx]
     if _cross(b - a, c - b) > eps:
         tris.append((idx[0], idx[1], idx[2]))
+    tris = _flip_slivers(pts, tris, eps)
     out = np.array(tris, dtype=np.int64).reshape(-1, 3)
     return out if ccw else out[:, ::-1]
 
@@ -82,3 +83,46 @@ def _find_ear(poly: np.ndarray, eps: float) -> int:
         if not inside.any():
             return int(i)
     return int(np.argmax(turn))
+
+
+def _shape(pts: np.ndarray, tri) -> float:
+    """Shape quality of a counter-clockwise triangle: area over the sum of squared sides
+    (largest for an equilateral one, 0 for a sliver)."""
+    a, b, c = pts[list(tri)]
+    sides = float(((b - a) ** 2).sum() + ((c - b) ** 2).sum() + ((a - c) ** 2).sum())
+    return 0.5 * float(_cross(b - a, c - a)) / sides
+
+
+def _flip_slivers(pts: np.ndarray, tris: list, eps: float) -> list:
+    """Flip diagonals while that improves the worse-shaped of the two triangles sharing them."""
+    tris = [tuple(t) for t in tris]
+    for _ in range(4 * len(tris) + 4):
+        owner = {}
+        for i, (a, b, c) in enumerate(tris):
+            for e in ((a, b), (b, c), (c, a)):
+                owner[e] = i
+        flipped = False
+        for i, tri in enumerate(tris):
+            for k in range(3):
+                a, b, c = tri[k], tri[(k + 1) % 3], tri[(k + 2) % 3]
+                j = owner.get((b, a))
+                if j is None or j == i:
+                    continue
+                other = tris[j]
+                d = other[(other.index(b) + 2) % 3]  # the apex of the neighbour across a-b
+                quad = pts[[a, d, b, c]]
+                turns = _cross(np.roll(quad, -1, axis=0) - quad,
+                               np.roll(quad, -2, axis=0) - np.roll(quad, -1, axis=0))
+                if (turns <= eps).any():
+                    continue
+                old = min(_shape(pts, tri), _shape(pts, other))
+                new_tris = ((a, d, c), (d, b, c))
+                if min(_shape(pts, t) for t in new_tris) > old * (1.0 + 1e-9) + 1e-15:
+                    tris[i], tris[j] = new_tris
+                    flipped = True
+                    break
+            if flipped:
+                break
+        if not flipped:
+            break
+    return tris
