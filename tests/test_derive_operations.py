@@ -1,0 +1,77 @@
+"""Operations not covered elsewhere: i() with assets, taper, every roof kind, offset, appearance."""
+
+import json
+
+import numpy as np
+import pytest
+import trimesh
+
+import bgr
+from bgr.interpreter.terminals import world_vertices
+
+
+def table(src, **kw):
+    return bgr.derive(bgr.load(src), **kw).terminals
+
+
+def bounds_of(t, row):
+    mesh = t.library.meshes[t.mesh[row]]
+    pts = world_vertices(t, np.array([row]), mesh)[0]
+    return pts.min(axis=0), pts.max(axis=0)
+
+
+@pytest.mark.parametrize("ext", ["obj", "glb", "ply"])
+def test_assets_are_fitted_to_the_scope(tmp_path, ext):
+    trimesh.creation.box(extents=(2, 4, 1)).export(tmp_path / f"pillar.{ext}")
+    src = tmp_path / "a.bgr"
+    src.write_text(f'asset pillar = "pillar.{ext}"\nLot --> s(3, 6, 1.5) i(pillar) P\nterminal P\n')
+    t = table(src)
+    lo, hi = bounds_of(t, 0)
+    np.testing.assert_allclose(hi - lo, [3, 6, 1.5], atol=1e-9)
+    assert t.geometry_names() == ["pillar"]
+
+
+def test_asset_with_two_zero_sizes_scales_uniformly(tmp_path):
+    trimesh.creation.box(extents=(2, 4, 1)).export(tmp_path / "p.obj")
+    src = tmp_path / "a.bgr"
+    src.write_text('asset p = "p.obj"\nLot --> s(0, 8, 0) i(p) P\nterminal P\n')
+    np.testing.assert_allclose(table(src).size[0], [4, 8, 2], atol=1e-9)
+
+
+def test_taper_narrows_the_top():
+    t = table("Lot --> taper(10, 0.5) M\nterminal M\n", lot=(10, 10))
+    mesh = t.library.meshes[t.mesh[0]]
+    pts = world_vertices(t, np.array([0]), mesh)[0]
+    top = pts[np.isclose(pts[:, 1], 10)]
+    assert top[:, 0].min() == pytest.approx(2.5) and top[:, 0].max() == pytest.approx(7.5)
+    assert trimesh.Trimesh(pts, mesh.faces).is_watertight
+
+
+@pytest.mark.parametrize("kind", ["flat", "gable", "hip", "pyramid", "shed", "mansard", "gambrel"])
+def test_every_roof_kind_on_a_lot(kind):
+    t = table(f"Lot --> extrude(5) comp(f) {{ top: roof({kind}, 35, 0.3) R }}\nterminal R\n", lot=(12, 8))
+    lo, hi = bounds_of(t, 0)
+    assert np.isfinite(lo).all() and np.isfinite(hi).all()
+    assert lo[1] >= 5 - 0.3 * np.tan(np.radians(80)) - 1e-6  # eaves drop by the overhang at most
+    assert 12 - 1e-6 <= hi[0] - lo[0] <= 12 + 4 * 0.3  # the overhang may widen the roof
+    if kind != "flat":
+        assert hi[1] > 6
+
+
+def test_offset_inside_and_border_tile_the_face():
+    t = table("Lot --> offset(1) { inside: I | border: B }\nterminal I, B\n", lot=(10, 6))
+    assert t.label == ["I", "B"]
+    np.testing.assert_allclose(t.size[0], [8, 0, 4])
+    areas = [trimesh.Trimesh(world_vertices(t, np.array([i]), t.library.meshes[t.mesh[i]])[0],
+                             t.library.meshes[t.mesh[i]].faces).area for i in range(2)]
+    assert sum(areas) == pytest.approx(60) and areas[0] == pytest.approx(32)
+
+
+def test_colour_material_and_label_reach_the_terminal_list(tmp_path):
+    src = 'Lot --> color(0, 0.5, 1) material("glass") label("Window") W\nW --> NIL G\nterminal G\n'
+    r = bgr.derive(bgr.load('Lot --> color(0, 0.5, 1) material("glass") label("Window") G\nterminal G\n'))
+    r.save(tmp_path / "t.json")
+    term = json.loads((tmp_path / "t.json").read_text())["terminals"][0]
+    assert (term["color"], term["material"], term["label"], term["rule"]) == ("#0080ff", "glass", "Window", "G")
+    assert src  # the deleted variant derives to nothing
+    assert len(bgr.derive(bgr.load(src))) == 0
