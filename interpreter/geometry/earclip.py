@@ -85,44 +85,57 @@ def _find_ear(poly: np.ndarray, eps: float) -> int:
     return int(np.argmax(turn))
 
 
-def _shape(pts: np.ndarray, tri) -> float:
-    """Shape quality of a counter-clockwise triangle: area over the sum of squared sides
-    (largest for an equilateral one, 0 for a sliver)."""
-    a, b, c = pts[list(tri)]
-    sides = float(((b - a) ** 2).sum() + ((c - b) ** 2).sum() + ((a - c) ** 2).sum())
-    return 0.5 * float(_cross(b - a, c - a)) / sides
+def _shape(p, a: int, b: int, c: int) -> float:
+    """Shape quality of a counter-clockwise triangle: area over the sum of its squared sides
+    (1 / (4 sqrt 3) for an equilateral one, 0 for a sliver)."""
+    (ax, ay), (bx, by), (cx, cy) = p[a], p[b], p[c]
+    sides = (bx - ax) ** 2 + (by - ay) ** 2 + (cx - bx) ** 2 + (cy - by) ** 2 + (ax - cx) ** 2 \
+        + (ay - cy) ** 2
+    return 0.5 * ((bx - ax) * (cy - ay) - (by - ay) * (cx - ax)) / sides
+
+
+_POOR = 0.05  # triangles shaped worse than this are worth a flip
 
 
 def _flip_slivers(pts: np.ndarray, tris: list, eps: float) -> list:
-    """Flip diagonals while that improves the worse-shaped of the two triangles sharing them."""
-    tris = [tuple(t) for t in tris]
-    for _ in range(4 * len(tris) + 4):
-        owner = {}
-        for i, (a, b, c) in enumerate(tris):
-            for e in ((a, b), (b, c), (c, a)):
-                owner[e] = i
+    """Flip diagonals while that improves the worse-shaped of two poorly shaped neighbours."""
+    p = pts.tolist()
+    tris = [tuple(int(v) for v in t) for t in tris]
+    owner = {}
+    for i, (a, b, c) in enumerate(tris):
+        owner[(a, b)] = owner[(b, c)] = owner[(c, a)] = i
+    for _ in range(20):  # sweeps
         flipped = False
-        for i, tri in enumerate(tris):
+        for i in range(len(tris)):
             for k in range(3):
+                tri = tris[i]
                 a, b, c = tri[k], tri[(k + 1) % 3], tri[(k + 2) % 3]
                 j = owner.get((b, a))
                 if j is None or j == i:
                     continue
                 other = tris[j]
                 d = other[(other.index(b) + 2) % 3]  # the apex of the neighbour across a-b
-                quad = pts[[a, d, b, c]]
-                turns = _cross(np.roll(quad, -1, axis=0) - quad,
-                               np.roll(quad, -2, axis=0) - np.roll(quad, -1, axis=0))
-                if (turns <= eps).any():
+                old = min(_shape(p, *tri), _shape(p, *other))
+                if old >= _POOR or not _strictly_convex([p[a], p[d], p[b], p[c]], eps):
                     continue
-                old = min(_shape(pts, tri), _shape(pts, other))
-                new_tris = ((a, d, c), (d, b, c))
-                if min(_shape(pts, t) for t in new_tris) > old * (1.0 + 1e-9) + 1e-15:
-                    tris[i], tris[j] = new_tris
+                first, second = (a, d, c), (d, b, c)
+                if min(_shape(p, *first), _shape(p, *second)) > old * (1.0 + 1e-9):
+                    for t in (tri, other):
+                        for e in ((t[0], t[1]), (t[1], t[2]), (t[2], t[0])):
+                            del owner[e]
+                    tris[i], tris[j] = first, second
+                    for n, t in ((i, first), (j, second)):
+                        for e in ((t[0], t[1]), (t[1], t[2]), (t[2], t[0])):
+                            owner[e] = n
                     flipped = True
-                    break
-            if flipped:
-                break
         if not flipped:
             break
     return tris
+
+
+def _strictly_convex(quad, eps: float) -> bool:
+    for q in range(4):
+        (ax, ay), (bx, by), (cx, cy) = quad[q], quad[(q + 1) % 4], quad[(q + 2) % 4]
+        if (bx - ax) * (cy - by) - (by - ay) * (cx - bx) <= eps:
+            return False
+    return True

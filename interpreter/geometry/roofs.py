@@ -19,7 +19,9 @@ Kinds
     until they meet the wall: the wall's face is a vertical triangle in the wall's plane.  A convex
     quadrilateral whose hip roof has no ridge (a square) gets gables on the two edges beside its
     front edge (``polygon[0] -> polygon[1]``), so the ridge runs parallel to the front.  Shapes
-    with no wing end (a regular hexagon) keep their hip roof.
+    with no wing end (a regular hexagon) keep their hip roof.  A gable whose wall would not stay
+    a wall in the eave polygon (next to a reflex corner there, once an overhang has closed a
+    notch) is made a slope again, rising from the eave.
 ``pyramid``
     One apex, one triangle per edge.  The apex is above the centroid or the pole of
     inaccessibility, whichever is farther from the boundary (the centroid on a tie), among those
@@ -45,14 +47,16 @@ Overhang
 --------
 ``overhang`` moves the eaves outward horizontally by that distance while every roof plane stays
 the plane of the roof without overhang: a plane at pitch ``p`` still passes through its wall-top
-edge at z = 0, and the eave ends ``overhang * tan(p)`` lower.  For the skeleton kinds the roof is
-the skeleton of the *eave polygon* — the footprint grown outward by the overhang (mitred corners;
-gable walls stay in their plane) — lowered by that amount; a shed and a flat roof cover the same
-eave polygon; a pyramid is extended about its apex so that every eave is at ``-overhang *
-tan(pitch)``.  The eave polygon is grown by the outward wavefront with its events, so an overhang
-wider than a small indent closes it, and one that would make opposite eaves meet across a narrow
-courtyard covers it; there the eave polygon has lost edges and the roof near them is the roof of
-the grown shape rather than an extension of the roof without overhang.
+edge at z = 0, and the eave ends ``overhang * tan(p)`` lower (for a mansard or gambrel, ``p`` is
+the lower band's pitch); gable walls do not move, so a gable end has no overhang.  For the
+skeleton kinds the roof is the skeleton of the *eave polygon* — the footprint grown outward by the
+overhang (mitred corners; gable walls stay in their plane) — lowered by that amount; a shed and a
+flat roof cover the same eave polygon; a pyramid is extended about its apex so that every eave is
+at ``-overhang * tan(pitch)`` (its eaves reach at least ``overhang`` out).  The eave polygon is
+grown by the outward wavefront with its events, so an overhang wider than a small indent closes
+it, and one that would make opposite eaves meet across a narrow courtyard covers it; there the
+eave polygon has lost edges and the roof near them is the roof of the grown shape rather than an
+extension of the roof without overhang.
 
 Output
 ------
@@ -428,7 +432,8 @@ def _pyramid_apex(fp: _Footprint):
 def _kernel(pts: np.ndarray, nrm: np.ndarray, c: np.ndarray, margin: float):
     """The polygon's kernel (where every edge is seen from inside), shrunk by ``margin``."""
     lo, hi = pts.min(axis=0), pts.max(axis=0)
-    poly = [np.array(p, dtype=np.float64) for p in ((lo[0], lo[1]), (hi[0], lo[1]), hi, (lo[0], hi[1]))]
+    box = ((lo[0], lo[1]), (hi[0], lo[1]), hi, (lo[0], hi[1]))
+    poly = [np.array(p, dtype=np.float64) for p in box]
     for k in range(len(pts)):
         poly = _clip_half_plane(poly, nrm[k], c[k] + margin)
         if len(poly) < 3:
@@ -487,8 +492,10 @@ def _shed_roof(fp: _Footprint, pitch: float, overhang: float) -> RoofMesh:
     behind = min(0.0, float((pts @ nrm[f] - c[f]).min()))  # corners behind the front line
     top = tan * (ring @ nrm[f] - c[f] - behind)
     bottom = float(top.min())
-    low = top - bottom <= 1e-9 * fp.scale  # corners on the eave: top and bottom are one vertex
-    vertices = np.vstack([np.column_stack([ring, top]), np.column_stack([ring, np.full(n, bottom)])])
+    low = top - bottom <= _CLEAN_TOL * fp.scale  # corners on the eave: one vertex, at the eave
+    top[low] = bottom
+    vertices = np.vstack([np.column_stack([ring, top]),
+                          np.column_stack([ring, np.full(n, bottom)])])
     below = np.where(low, np.arange(n), np.arange(n) + n)
     builder = _MeshBuilder(vertices)
     roof = builder.plane("roof", lambda: _slope_plane(fp, f, tan, behind, 0.0))

@@ -29,14 +29,25 @@ few hundred vertices):
    collapsed to zero area (their remaining edges are the ridges);
 4. repeat until no polygon is left.
 
+One more clean-up rule keeps nearly degenerate input (footprints with coordinate noise) sane: a
+vertex between two nearly antiparallel edges runs almost infinitely fast along the thin spike
+those edges form, so a tolerance-sized error in when it was made would send it anywhere; when the
+spike is thinner than ``ZIP_TOL`` it is zipped up at once (the end of its shorter side is split
+onto the other side), which is where that vertex was going.
+
 Every vertex leaves a straight *arc* from where it was born to where it died; each arc bounds the
 faces of the vertex's two edges, and each collapsed polygon's last edges bound their own faces.
-The faces are then assembled from those segments: nodes closer than a tolerance are merged,
+The faces are then assembled from those segments: nodes closer than ``SNAP`` are merged,
 segments are split where another node lies on them (no T-junctions), and each face's boundary is
 walked as a planar graph.  Optional *break times* cut the whole wavefront at given offsets, so that
 each face is split into stages (a mansard roof's steep lower band and shallow upper part).
 
+The same wavefront run on the reversed polygon grows it outward (:func:`offset_outward`), with its
+events: that is how a roof's eaves are laid out for an overhang.
+
 Coordinates are scaled to a unit-size polygon while computing, so the tolerances are relative.
+The loop is O(n^2) numpy work per event and O(n) events: a 200-vertex footprint takes a fraction
+of a second.
 """
 
 from __future__ import annotations
@@ -91,7 +102,7 @@ def straight_skeleton(polygon, weights=None, breaks=()) -> Skeleton:
     pts = np.asarray(polygon, dtype=np.float64)
     n = len(pts)
     if n < 3 or signed_area(pts) <= 0:
-        raise ValueError("straight_skeleton needs a counter-clockwise polygon of 3 or more vertices")
+        raise ValueError("straight_skeleton needs a counter-clockwise polygon of 3+ vertices")
     w = np.ones(n) if weights is None else np.asarray(weights, dtype=np.float64)
     lo, hi = pts.min(axis=0), pts.max(axis=0)
     centre, scale = (lo + hi) / 2.0, float((hi - lo).max())

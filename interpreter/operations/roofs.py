@@ -32,7 +32,10 @@ def roof(app, shape, step, args) -> bool:
     verts, faces = [], []
     base = 0
     for ext, _holes in metric(polys, shape.size[p], shape.size[q]):
-        m = roof_mesh(np.asarray(ext, dtype=float), kind, float(pitch), float(overhang))
+        try:
+            m = roof_mesh(np.asarray(ext, dtype=float), kind, float(pitch), float(overhang))
+        except ValueError as e:  # a footprint the roof builder cannot use (not simple, degenerate)
+            raise runtime_error(app.module, step.pos, f"cannot build a {kind} roof on this footprint: {e}") from None
         verts.append(m.vertices)
         faces.append(m.faces + base)
         base += len(m.vertices)
