@@ -1,9 +1,13 @@
 """Component splits: the face frames of LANGUAGE.md section 7, selectors, comp.index/total."""
 
+import io
+import json
+
 import numpy as np
 import pytest
 
 import bgr
+from bgr.interpreter.writers import write_json
 
 BOX = """Lot --> extrude(4) comp(f) { front: F | back: B | left: L | right: R | top: T | bottom: Bo }
 terminal F, B, L, R, T, Bo
@@ -11,8 +15,12 @@ terminal F, B, L, R, T, Bo
 
 
 def faces(src=BOX, lot=(10, 6)):
-    t = bgr.derive(bgr.load(src), lot=lot).terminals
-    return {label: (t.origin[i], t.axes[i], t.size[i]) for i, label in enumerate(t.label)}
+    """label -> (origin, axes, size) read from the JSON terminal list."""
+    result = bgr.derive(bgr.load(src), lot=lot)
+    buffer = io.StringIO()
+    write_json(result.terminals, buffer, seed=result.seed, attrs=result.attrs)
+    return {t["label"]: (np.array(t["origin"]), np.array(t["axes"]), np.array(t["size"]))
+            for t in json.loads(buffer.getvalue())["terminals"]}
 
 
 @pytest.mark.parametrize("label, origin, x, y, z, size", [

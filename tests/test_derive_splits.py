@@ -1,8 +1,12 @@
 """The split solver and the split operation, against every example row of LANGUAGE.md section 6."""
 
+import io
+import json
+
 import pytest
 
 import bgr
+from bgr.interpreter.writers import write_json
 from bgr.interpreter.split_solver import Piece, Repeat, solve
 
 
@@ -12,8 +16,14 @@ def pieces(block: str, length: float = 10.0):
                        if w[:1].isupper()))
     src = f"Lot --> split(x) {block}\n" + "".join(f"{name} --> color(\"#ffffff\")\n" for name in names)
     result = bgr.derive(bgr.load(src), lot=(length, 5.0))
-    t = result.terminals
-    return [(label, round(float(size[0]), 6)) for label, size in zip(t.label, t.size)]
+    return [(t["label"], round(t["size"][0], 6)) for t in terminal_list(result)]
+
+
+def terminal_list(result) -> list[dict]:
+    """The terminals as the .json writer prints them: what these tests read."""
+    buffer = io.StringIO()
+    write_json(result.terminals, buffer, seed=result.seed, attrs=result.attrs)
+    return json.loads(buffer.getvalue())["terminals"]
 
 
 @pytest.mark.parametrize("block, length, expected", [
