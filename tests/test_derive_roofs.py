@@ -97,3 +97,19 @@ def test_roof_eaves_are_the_wall_tops(tmp_path, name, kind):
     # a hip roof is closed above the footprint: its only open edges are the eaves
     if kind == "hip":
         assert len(eaves) == len(boundary)
+
+
+@pytest.mark.parametrize("w, d, overhang", [(14.3, 11.2, 0.4), (8, 12, 0), (10, 10, 0.3), (20, 3, 0.5)])
+def test_closed_form_rectangle_hip_matches_the_straight_skeleton(w, d, overhang):
+    import trimesh
+
+    from bgr.interpreter.geometry.rect_roofs import rectangle_hip
+    from bgr.interpreter.geometry.roofs import roof_mesh
+
+    general = roof_mesh(np.array([[0, 0], [w, 0], [w, d], [0, d]], float), "hip", 30, overhang)
+    v, f = rectangle_hip(w, d, 30, overhang)
+    used = lambda verts, faces: sorted(set(map(tuple, np.round(verts[np.unique(faces)], 6))))  # noqa: E731
+    assert used(v, f) == used(general.vertices, general.faces)
+    fast = trimesh.Trimesh(v, f, process=False)
+    assert fast.area == pytest.approx(trimesh.Trimesh(general.vertices, general.faces, process=False).area)
+    assert (fast.face_normals[:, 2] > 0).all()

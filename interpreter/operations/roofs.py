@@ -7,6 +7,7 @@ import numpy as np
 from ..expressions import runtime_error
 from ..geometry.meshes import PLANE_AXES
 from ..geometry.polygons import RECT, UNIT_SQUARE, metric
+from ..geometry.rect_roofs import rectangle_hip
 from ..shapes import Flat, Solid
 from ..terminals import UnitMesh
 
@@ -31,6 +32,11 @@ def roof(app, shape, step, args) -> bool:
     polys = [(UNIT_SQUARE, ())] if geom.polys == RECT else geom.polys
     verts, faces = [], []
     base = 0
+    if geom.polys == RECT and kind == "hip":  # the common case, in closed form
+        v, f = rectangle_hip(shape.size[p], shape.size[q], float(pitch), float(overhang))
+        verts.append(v)
+        faces.append(f)
+        polys = []
     for ext, _holes in metric(polys, shape.size[p], shape.size[q]):
         try:
             m = roof_mesh(np.asarray(ext, dtype=float), kind, float(pitch), float(overhang))
