@@ -52,7 +52,8 @@ class Engine:
         self._exprs: dict[int, object] = {}
         self._flat_ids: dict[tuple, int] = {}
         self.split_cache: dict = {}  # (block id, sizes, length) -> placed pieces
-        self.signatures: dict[int, tuple] = {}  # id(operation node) -> its signature (the grammar outlives us)
+        self.signatures: dict[int, tuple] = {}
+        self.uses_center: dict[int, bool] = {}  # id(step list) -> does it call center()?  # id(operation node) -> its signature (the grammar outlives us)
 
     def _prepare_values(self, grammar, overrides: dict) -> dict:
         unknown = [k for k in overrides if k not in grammar.attrs]
@@ -206,7 +207,7 @@ class Application:
         """Run steps on ``shape``; a shape that no successor took and nothing consumed or deleted
         becomes a terminal, in its place among the children (depth first, children in order)."""
         spawned = self.counter
-        if not self.steps(shape, steps, shape.copy()) and self.counter == spawned:
+        if not self.steps(shape, steps, self.snapshot(shape, steps)) and self.counter == spawned:
             self.children.append((EMIT, shape, self.rule.name, self.rule.name))
 
     def steps(self, shape: Shape, steps, received: Shape) -> bool:
@@ -229,9 +230,18 @@ class Application:
                 self.ctx.shape = shape
                 return True
             elif isinstance(step, n.Push):
-                self.steps(shape.copy(), step.steps, shape.copy())
+                self.steps(shape.copy(), step.steps, self.snapshot(shape, step.steps))
         self.ctx.shape = shape
         return consumed
+
+    def snapshot(self, shape: Shape, steps) -> Shape | None:
+        """The scope center() aligns to, copied only for step lists that call center()."""
+        uses = self.engine.uses_center
+        key = id(steps)
+        found = uses.get(key)
+        if found is None:
+            found = uses[key] = any(isinstance(s, n.Operation) and s.name == "center" for s in steps)
+        return shape.copy() if found else None
 
     def arguments(self, step: n.Operation, received: Shape) -> list:
         """Evaluated arguments by the registry's signature: bare words stay words, a relative
