@@ -945,3 +945,20 @@ def test_bug8_formatted_commented_rule_parses_fast(tmp_path):
         pytest.fail("bgr check took more than 5 s on the output of bgr fmt")
     _assert_clean_process(proc)
     assert proc.returncode == 0
+
+
+# ---- the interpreter: generated grammars derive or fail with a located BgrError ---------------
+
+@fuzz_settings(150)
+@given(valid_grammars(comments=False))
+def test_generated_grammars_derive_or_fail_cleanly(case):
+    """No grammar makes `bgr derive` raise anything but BgrError (type faults, limits, ...)."""
+    text, _ = case
+    try:
+        grammar = bgr.load(text, path=str(ROOT / "examples" / "fuzz.bgr"))
+    except BgrError:
+        return
+    try:
+        bgr.derive(grammar, seed=1, lot=(10, 8), max_shapes=3000, max_depth=25)
+    except BgrError as e:
+        assert e.message
