@@ -218,13 +218,15 @@ class Application:
         that no successor takes is dropped.
         """
         consumed = False
+        last = steps[-1] if steps else None
         for step in steps:
             self.ctx.shape = shape
             if isinstance(step, n.Operation):
                 if IMPLEMENTATIONS[step.name](self, shape, step, self.arguments(step, received)):
                     consumed = True
             elif isinstance(step, n.Successor):
-                self.successor(shape, step)
+                # the last step may hand the shape itself over: nothing uses it afterwards
+                self.successor(shape, step, handover=step is last)
                 consumed = True
             elif isinstance(step, n.Nil):  # the shape is deleted: later steps have nothing to work on
                 self.ctx.shape = shape
@@ -268,10 +270,10 @@ class Application:
         out.append(received)
         return out
 
-    def successor(self, shape: Shape, step: n.Successor) -> None:
+    def successor(self, shape: Shape, step: n.Successor, handover: bool = False) -> None:
         module, member = self.module.lookup_module(step.name)
         args = [self.value(a.expr if isinstance(a, n.Relative) else a) for a in step.args]
-        child = shape.copy()
+        child = shape if handover else shape.copy()
         index = self.counter
         self.counter += 1
         child.path = f"{shape.path}/{member}.{index}"
