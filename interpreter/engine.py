@@ -11,13 +11,13 @@ from __future__ import annotations
 import gc
 
 from bgr.grammar import nodes as n
-from bgr.grammar.registry import AXES, AXIS, COMP_KIND, GEOMETRY, OPERATIONS, ROOF_KIND, SIZE
+from bgr.grammar.registry import AXES, AXIS, COMP_KIND, GEOMETRY, OPERATIONS, ROOF_KIND
 
 from bgr.grammar.errors import BgrError, Diagnostic, suggest
 
 from .expressions import Compiler, Context, evaluate_values, runtime_error
 from .randomness import Stream, child_hash, name_hash, root_hash
-from .shapes import Flat, Prism, Shape, Solid
+from .shapes import Flat, Shape, Solid
 from .terminals import TerminalTable, UnitMesh
 from .geometry import meshes
 from .geometry.polygons import RECT

@@ -14,8 +14,7 @@ import sys
 
 import pytest
 
-import bgr
-from errors_helpers import bug, check, first_error
+from errors_helpers import check, first_error
 
 
 # (source, line, column, message substring, hint substring or None)

@@ -10,7 +10,7 @@ from __future__ import annotations
 import pytest
 
 import bgr
-from errors_helpers import bug, check, first_error
+from errors_helpers import check, first_error
 
 # Words that must never reach a user: Lark's terminal names and Python internals.
 LARK_WORDS = ("__ANON", "LPAR", "RPAR", "LBRACE", "RBRACE", "LSQB", "RSQB", "$END", "RULE_NAME",

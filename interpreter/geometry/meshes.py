@@ -55,7 +55,6 @@ def prism_mesh(polys, k: int) -> tuple[np.ndarray, np.ndarray]:
     faces = [_orient(bottom, tris, lambda c: np.broadcast_to(-normal, c.shape)),
              _orient(top, tris, lambda c: np.broadcast_to(normal, c.shape)) + len(bottom)]
     base = len(bottom) + len(top)
-    centre2 = pts2.mean(axis=0) if len(pts2) else np.zeros(2)
     for ext, holes in polys:
         for ring, is_hole in [(ext, False)] + [(h, True) for h in holes]:
             ring = np.asarray(ring, dtype=np.float64)
@@ -74,7 +73,6 @@ def prism_mesh(polys, k: int) -> tuple[np.ndarray, np.ndarray]:
                 verts.append(quad)
                 faces.append(tri + base)
                 base += 4
-    del centre2
     return np.vstack(verts), np.vstack(faces)
 
 
@@ -98,7 +96,7 @@ def primitive(name: str) -> tuple[np.ndarray, np.ndarray]:
     if name == "quad":
         return flat_mesh(RECT, 2)
     if name == "wedge":  # a right prism on a triangle in the yz plane, sloping down to +z
-        tri = [(((0.0, 0.0), (1.0, 0.0), (0.0, 1.0)), ())]  # (y, z) coordinates... as (x-plane)
+        tri = [(((0.0, 0.0), (1.0, 0.0), (0.0, 1.0)), ())]  # a right triangle in the (y, z) plane
         return prism_mesh(tri, 0)
     if name == "cylinder":
         n = 24

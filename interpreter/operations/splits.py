@@ -14,7 +14,7 @@ from bgr.grammar import nodes as n
 from ..expressions import runtime_error
 from ..geometry.meshes import PLANE_AXES
 from ..geometry.polygons import RECT, clip, renormalise
-from ..shapes import Flat, Prism, Solid
+from ..shapes import Prism, Solid
 from ..split_solver import Piece, Repeat, solve
 
 def _items(app, entries) -> tuple:
