@@ -12,13 +12,15 @@ from dataclasses import dataclass, field
 
 from . import nodes as n
 from .errors import Diagnostic, source_line, suggest
+from .formatter import format_params
 from .registry import (AXES, AXIS, AXIS_NAMES, BUILTIN_NAMES, BUILTINS, COLOR, COMP_KIND, COMP_KINDS,
                        COMP_SELECTORS, GEOMETRY, KEYWORDS, NUMBER, OFFSET_SELECTORS, OPERATIONS,
-                       PRIMITIVES, ROOF_KIND, ROOF_KINDS, SIZE, STRING, Op)
+                       PRIMITIVES, ROOF_KIND, ROOF_KINDS, SIZE, STRING, Op, FOOTPRINT_KIND, FOOTPRINT_KINDS)
 
 KNOWN_VERSIONS = (1,)
 _COLOR_RE = re.compile(r"#[0-9a-fA-F]{6}\Z")
-_SYMBOL_KINDS = {AXIS: AXIS_NAMES, COMP_KIND: COMP_KINDS, ROOF_KIND: ROOF_KINDS}
+_SYMBOL_KINDS = {AXIS: AXIS_NAMES, COMP_KIND: COMP_KINDS, ROOF_KIND: ROOF_KINDS,
+                 FOOTPRINT_KIND: FOOTPRINT_KINDS}
 _RESERVED_ALIASES = {"scope", "split", "comp", "stdlib"}
 
 
@@ -171,9 +173,23 @@ class Checker:
                 pos = item.param_pos[i] if i < len(item.param_pos) else item.pos
                 self.error(pos, f"parameter '{p}' appears twice in this {what}", length=len(p))
             seen.add(p)
+        if isinstance(item, n.Rule):
+            defaulted = False
+            for i, p in enumerate(item.params):
+                pos = item.param_pos[i] if i < len(item.param_pos) else item.pos
+                if item.default(i) is not None:
+                    defaulted = True
+                elif defaulted:
+                    self.error(pos, f"parameter '{p}' has no default but follows one that has",
+                               f"give it a default ('{p} = ...') or move it before the defaulted ones",
+                               len(p))
 
     # ---- rules ----------------------------------------------------------------------------
     def rule(self, rule: n.Rule) -> None:
+        for i, p in enumerate(rule.params):  # a default sees the parameters before it
+            default = rule.default(i)
+            if default is not None and not self.is_rule_ref(default):
+                self.expr(default, set(rule.params[:i]), in_rule=True)
         local = set(rule.params)
         body = rule.body
         if isinstance(body, n.Sequence):
@@ -212,9 +228,22 @@ class Checker:
             for inner in step.steps:
                 self.step(inner, local)
 
+    def is_rule_ref(self, e, local: set[str] = frozenset()) -> bool:
+        """A bare name of a rule or terminal, handed whole to a rule parameter (``window = Arched``)."""
+        if not isinstance(e, n.Name) or e.name in local:
+            return False
+        module, member = self.g.lookup_module(e.name)
+        if module is self.g and "." in e.name:
+            return False
+        return member in module.rules or member in module.terminals
+
     def successor(self, step: n.Successor, local: set[str]) -> None:
         for arg in step.args:
-            self.arg(arg, local, relative_ok=False)
+            value = arg.value if isinstance(arg, n.Keyword) else arg
+            if not self.is_rule_ref(value, local):
+                self.arg(arg, local, relative_ok=False)
+        if step.name in local:  # a parameter that holds a rule: checked when it is applied
+            return
         module, member = self.g.lookup_module(step.name)
         if module is not self.g or "." in step.name:
             alias = step.name.split(".", 1)[0]
@@ -224,11 +253,10 @@ class Checker:
                 self.unknown_alias(alias, step.pos)
                 return
         if member in module.rules:
-            params = module.rules[member].params
-            if len(step.args) != len(params):
-                want = f"{member}({', '.join(params)})" if params else member
-                self.error(step.pos, f"rule '{step.name}' takes {_count(len(params), 'argument')}, "
-                           f"given {len(step.args)}", f"it is declared as {want}", len(step.name))
+            problem = bind_problem(module.rules[member], step.args, step.name)
+            if problem is not None:
+                pos, message, hint = problem
+                self.error(pos or step.pos, message, hint, None if pos else len(step.name))
         elif member in module.terminals:
             if step.args:
                 self.error(step.pos, f"terminal '{step.name}' takes no arguments", length=len(step.name))
@@ -383,7 +411,9 @@ class Checker:
 
     # ---- expressions ----------------------------------------------------------------------
     def arg(self, arg, local: set[str], relative_ok: bool) -> None:
-        if isinstance(arg, n.Relative):
+        if isinstance(arg, n.Keyword):
+            self.expr(arg.value, local, in_rule=True)
+        elif isinstance(arg, n.Relative):
             if not relative_ok:
                 self.error(arg.pos, "a relative size ('f) is not allowed here",
                            "relative sizes go in s(), t() and split sizes")
@@ -427,6 +457,10 @@ class Checker:
                 module = self.g.imports[alias]
                 if member in module.attrs or member in module.consts:
                     return
+                if member in module.rules or member in module.terminals:
+                    self.error(e.pos, f"'{name}' is a rule, not a value",
+                               "a rule can only be handed whole to a rule parameter: R(part = Name)")
+                    return
                 hint = suggest(member, list(module.attrs) + list(module.consts))
                 self.error(e.pos, f"module '{alias}' has no attr or const '{member}'", hint)
                 return
@@ -438,7 +472,7 @@ class Checker:
             return
         if name in self.g.rules or name in self.g.terminals:
             self.error(e.pos, f"'{name}' is a rule, not a value",
-                       "rules are applied in a rule body, outside expressions")
+                       "a rule can only be handed whole to a rule parameter: R(part = Name)")
             return
         known = list(local) + list(self.g.attrs) + list(self.g.consts) + list(BUILTIN_NAMES)
         hint = suggest(name, known)
@@ -510,6 +544,38 @@ class Checker:
 
 def _article(what: str) -> str:
     return ("an " if what[0] in "aeiou" else "a ") + what
+
+
+def bind_problem(rule: n.Rule, args: list, called: str):
+    """Why ``args`` cannot bind ``rule``'s parameters, as (pos or None, message, hint); or None.
+
+    Positional arguments fill the parameters in order, keyword arguments name them, and every
+    parameter left over must have a default.  The interpreter asks the same question for a rule
+    handed over in a parameter, which the checker cannot see.
+    """
+    params = rule.params
+    want = f"it is declared as {rule.name}{format_params(rule)}" if params else f"'{rule.name}' takes no arguments"
+    positional = [a for a in args if not isinstance(a, n.Keyword)]
+    plain = not rule.defaults and len(positional) == len(args)
+    if len(positional) > len(params) or (plain and len(positional) != len(params)):
+        return None, (f"rule '{called}' takes {_count(len(params), 'argument')}, "
+                      f"given {len(positional)}"), want
+    bound = set(params[:len(positional)])
+    for arg in args:
+        if not isinstance(arg, n.Keyword):
+            continue
+        if arg.name not in params:
+            hint = suggest(arg.name, params) or want
+            return arg.pos, f"rule '{called}' has no parameter '{arg.name}'", hint
+        if arg.name in bound:
+            return arg.pos, f"parameter '{arg.name}' of rule '{called}' is given twice", want
+        bound.add(arg.name)
+    missing = [p for i, p in enumerate(params) if p not in bound and rule.default(i) is None]
+    if missing:
+        names = ", ".join(f"'{p}'" for p in missing)
+        noun = "parameter" if len(missing) == 1 else "parameters"
+        return None, f"rule '{called}' needs a value for {noun} {names}", want
+    return None
 
 
 def _count(k: int, word: str) -> str:

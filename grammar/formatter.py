@@ -112,7 +112,20 @@ def _is_signed(e) -> bool:
 
 
 def format_arg(a) -> str:
+    if isinstance(a, n.Keyword):
+        return f"{a.name} = {format_expr(a.value)}"
     return format_expr(a)
+
+
+def format_params(rule: n.Rule) -> str:
+    """``(w, d = 10)``, or nothing for a rule without parameters."""
+    if not rule.params:
+        return ""
+    parts = []
+    for i, p in enumerate(rule.params):
+        d = rule.default(i)
+        parts.append(p if d is None else f"{p} = {format_expr(d)}")
+    return f"({', '.join(parts)})"
 
 
 def _guarded(e) -> str:
@@ -210,7 +223,7 @@ class Formatter:
         raise TypeError(f"not a top-level item: {item!r}")
 
     def rule(self, rule: n.Rule, out: _Writer) -> None:
-        head = rule.name + (f"({', '.join(rule.params)})" if rule.params else "") + " -->"
+        head = rule.name + format_params(rule) + " -->"
         body = rule.body
         if isinstance(body, n.Sequence):
             out.write(head + " ")

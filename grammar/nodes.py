@@ -98,8 +98,17 @@ class Relative:
     pos: Pos = _pos()
 
 
+@dataclass
+class Keyword:
+    """``name = expr`` as a successor argument: binds the rule parameter ``name`` (``Tile(w = 2)``)."""
+
+    name: str
+    value: Expr
+    pos: Pos = _pos()
+
+
 Expr = Union[Number, String, Bool, Name, Call, Unary, Binary, Ternary]
-Arg = Union[Expr, Relative]
+Arg = Union[Expr, Relative, Keyword]
 
 
 # ---- rule bodies -----------------------------------------------------------------------------
@@ -217,11 +226,18 @@ Body = Union[Sequence, Stochastic, Conditional]
 
 @dataclass
 class Rule:
+    """``Name(p1, p2 = default) --> body``; ``defaults`` holds one Expr or None per parameter."""
+
     name: str
     params: list[str]
     body: Body
     pos: Pos = _pos()
     param_pos: list[Pos] = field(default_factory=list, compare=False, repr=False, kw_only=True)
+    defaults: list = field(default_factory=list, kw_only=True)
+
+    def default(self, i: int):
+        """The default expression of parameter ``i``, or None when it has none."""
+        return self.defaults[i] if i < len(self.defaults) else None
 
 
 @dataclass
@@ -326,3 +342,5 @@ def names_in(expr) -> "Iterator[Name]":
             stack += e.args
         elif isinstance(e, Relative):
             stack.append(e.expr)
+        elif isinstance(e, Keyword):
+            stack.append(e.value)

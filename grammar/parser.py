@@ -64,6 +64,25 @@ def _tok_pos(tok: Token) -> n.Pos:
     return n.Pos(tok.line, tok.column, tok.end_line or tok.line, tok.end_column or tok.column)
 
 
+def _keywords_last(args: list) -> None:
+    """``R(a = 1, 2)``: a positional argument after a keyword one is ambiguous, as in Python."""
+    seen_keyword = False
+    for arg in args:
+        if isinstance(arg, n.Keyword):
+            seen_keyword = True
+        elif seen_keyword:
+            raise _Problem(arg.pos, "a positional argument follows a keyword argument",
+                           "put the positional arguments first")
+
+
+def _no_keywords(args: list, what: str) -> None:
+    """Keyword arguments name rule parameters; operations and functions take positions only."""
+    for arg in args:
+        if isinstance(arg, n.Keyword):
+            raise _Problem(arg.pos, f"{what} takes no keyword arguments",
+                           f"write the value alone, without '{arg.name} ='", len(arg.name))
+
+
 class _Problem(Exception):
     """Raised by the tree builder for a construct the grammar accepts but the language does not."""
 
@@ -141,11 +160,18 @@ class _TreeBuilder(Transformer):
         if str(name_tok) in KEYWORDS:
             raise _Problem(_tok_pos(name_tok), f"'{name_tok}' is a keyword and cannot name a rule",
                            "choose another name, e.g. a capitalised one", len(name_tok))
-        return n.Rule(str(name_tok), [str(p) for p in params], body, pos=_span(c),
-                      param_pos=[_tok_pos(p) for p in params])
+        return n.Rule(str(name_tok), [str(p) for p, _ in params], body, pos=_span(c),
+                      param_pos=[_tok_pos(p) for p, _ in params],
+                      defaults=[d for _, d in params] if any(d is not None for _, d in params) else [])
 
     def rule_params(self, c):
         return c[0] if c and c[0] else []
+
+    def params(self, c):
+        return list(c)
+
+    def param(self, c):
+        return (c[0], c[1] if len(c) > 1 else None)
 
     def alternatives(self, alts):
         kinds = [kind for kind, *_ in alts]
@@ -188,7 +214,9 @@ class _TreeBuilder(Transformer):
 
     def call(self, c):
         name, args, block = str(c[0]), c[1] or [], c[2]
+        _keywords_last(args)
         if name in OPERATIONS:
+            _no_keywords(args, f"operation '{name}'")
             return n.Operation(name, args, block, pos=_span(c))
         if block is not None:
             hint = suggest(name, [op for op, spec in OPERATIONS.items() if spec.block])
@@ -224,6 +252,9 @@ class _TreeBuilder(Transformer):
     def rel_arg(self, c):
         return n.Relative(c[1], pos=_span(c))
 
+    def keyword_arg(self, c):
+        return n.Keyword(str(c[0]), c[1], pos=_tok_pos(c[0]))
+
     # ---- expressions ----------------------------------------------------------------------
     def number(self, c):
         return n.Number(_number(c[0]), pos=_tok_pos(c[0]))
@@ -245,7 +276,9 @@ class _TreeBuilder(Transformer):
         return n.Name(str(c[0]), pos=_tok_pos(c[0]))
 
     def fcall(self, c):
-        return n.Call(str(c[0]), c[1] or [], pos=_span(c))
+        args = c[1] or []
+        _no_keywords(args, f"function '{c[0]}'")
+        return n.Call(str(c[0]), args, pos=_span(c))
 
     def ternary(self, c):
         return n.Ternary(c[0], c[1], c[2], pos=_span(c))

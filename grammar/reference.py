@@ -7,7 +7,8 @@ A test keeps docs/operations.md equal to this output.
 
 from __future__ import annotations
 
-from .registry import BUILTIN_NAMES, BUILTINS, COMP_SELECTORS, OPERATIONS, PRIMITIVES, ROOF_KINDS
+from .registry import (BUILTIN_NAMES, BUILTINS, COMP_SELECTORS, FOOTPRINT_KINDS, OPERATIONS, PRIMITIVES,
+                       ROOF_KINDS)
 
 
 def _cell(text: str) -> str:
@@ -33,6 +34,7 @@ def reference_markdown() -> str:
     for name, doc in BUILTIN_NAMES.items():
         out.append(f"| `{name}` | {doc} |")
     out += ["", "Symbols: roof kinds " + ", ".join(f"`{k}`" for k in ROOF_KINDS)
+            + "; footprints " + ", ".join(f"`{k}`" for k in FOOTPRINT_KINDS)
             + "; primitives " + ", ".join(f"`{p}`" for p in PRIMITIVES)
             + "; component selectors " + ", ".join(f"`{s}`" for s in COMP_SELECTORS)
             + ", `face(i)`; offset selectors `inside`, `border`.", ""]

@@ -20,11 +20,13 @@ AXIS = "axis"  # x | y | z
 AXES = "axes"  # a non-empty combination of x, y, z: xz, xyz ...
 COMP_KIND = "comp kind"  # f (faces)
 ROOF_KIND = "roof kind"  # flat | gable | ...
+FOOTPRINT_KIND = "footprint kind"  # rect | L | U | T | cross | circle
 GEOMETRY = "geometry"  # a primitive or a declared asset
 
 AXIS_NAMES = ("x", "y", "z")
 COMP_KINDS = ("f",)
 ROOF_KINDS = ("flat", "gable", "hip", "pyramid", "shed", "mansard", "gambrel")
+FOOTPRINT_KINDS = ("rect", "L", "U", "T", "cross", "circle")
 PRIMITIVES = ("cube", "cylinder", "sphere", "quad", "wedge")
 COMP_SELECTORS = ("front", "back", "left", "right", "side", "top", "bottom", "all")
 OFFSET_SELECTORS = ("inside", "border")
@@ -99,6 +101,12 @@ OPERATIONS: dict[str, Op] = {
         Op("offset", "components", _sig(Param("distance", NUMBER)),
            "Inset a 2D face by a distance (a negative one grows it) into an inside and a border.",
            "offset(0.2) { inside: Glass | border: Frame }", block="offset"),
+        Op("footprint", "components",
+           _sig(Param("kind", FOOTPRINT_KIND), Param("a", NUMBER, 0.4), Param("b", NUMBER, -1.0)),
+           "Replace a 2D shape's outline by a building footprint filling its scope: `rect`, `L`, `U`, "
+           "`T`, `cross` (wing widths `a`, `b` as fractions of the scope; `b` defaults to `a`), "
+           "`circle` (`a` sides, at least 3 when given).",
+           "footprint(L, 0.4, 0.5)"),
         Op("extrude", "components", _sig(Param("height", NUMBER)),
            "Turn a 2D shape into a prism of the given height along its normal.",
            "extrude(12)"),

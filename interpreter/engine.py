@@ -11,11 +11,13 @@ from __future__ import annotations
 import gc
 
 from bgr.grammar import nodes as n
-from bgr.grammar.registry import AXES, AXIS, COMP_KIND, GEOMETRY, OPERATIONS, ROOF_KIND
+from bgr.grammar.registry import AXES, AXIS, COMP_KIND, FOOTPRINT_KIND, GEOMETRY, OPERATIONS, ROOF_KIND
 
 from bgr.grammar.errors import BgrError, Diagnostic, suggest
 
-from .expressions import Compiler, Context, evaluate_values, runtime_error
+from bgr.grammar.checker import bind_problem
+
+from .expressions import Compiler, Context, RuleRef, evaluate_values, runtime_error
 from .randomness import Stream, child_hash, name_hash, root_hash
 from .shapes import Flat, Shape, Solid
 from .terminals import TerminalTable, UnitMesh
@@ -23,7 +25,7 @@ from .geometry import meshes
 from .geometry.polygons import RECT
 from .operations import IMPLEMENTATIONS
 
-SYMBOL_KINDS = {AXIS, AXES, COMP_KIND, ROOF_KIND, GEOMETRY}
+SYMBOL_KINDS = {AXIS, AXES, COMP_KIND, ROOF_KIND, FOOTPRINT_KIND, GEOMETRY}
 EMIT = object()  # marks a children-list entry that is a finished terminal, kept in order
 _NAME_HASHES: dict[str, int] = {}
 
@@ -49,6 +51,7 @@ class Engine:
         self.attrs = self._prepare_values(grammar, dict(attrs or {}))
         self.table = TerminalTable()
         self.shapes = 0
+        self._bindings: dict = {}
         self._exprs: dict[int, object] = {}
         self._flat_ids: dict[tuple, int] = {}
         self.split_cache: dict = {}  # (block id, sizes, length) -> placed pieces
@@ -90,10 +93,13 @@ class Engine:
         if start is None or start not in grammar.rules:
             what = f"no rule '{start}'" if start else "no rules to derive"
             raise BgrError(Diagnostic(grammar.path, 0, 0, f"the grammar has {what}"))
-        if grammar.rules[start].params:
-            raise runtime_error(grammar, grammar.rules[start].pos,
-                                f"the start rule '{start}' takes parameters, but the lot comes with none",
-                                "start from a rule without parameters that calls this one")
+        head = grammar.rules[start]
+        required = [p for i, p in enumerate(head.params) if head.default(i) is None]
+        if required:
+            raise runtime_error(grammar, head.pos,
+                                f"the start rule '{start}' needs a value for {', '.join(required)}, "
+                                "but the lot comes with none",
+                                "give the parameters defaults ('w = 10'), or start from a rule that calls this one")
         lot.path = f"{start}.{index}" if several else start
         lot.hash = child_hash(root_hash(self.seed), name_hash(start), index)
         stack = [(lot, grammar, grammar.rules[start], {}, (0, 1, 0, 1))]
@@ -113,6 +119,17 @@ class Engine:
             if gc_was_on:
                 gc.enable()
         return self.table
+
+    def binding_problem(self, ref: RuleRef, step: n.Successor):
+        """bind_problem() for a rule held in a parameter, cached per (successor, rule)."""
+        key = (id(step), id(ref.module), ref.member)
+        if key not in self._bindings:
+            if ref.member in ref.module.rules:
+                found = bind_problem(ref.module.rules[ref.member], step.args, ref.member)
+            else:
+                found = (None, f"terminal '{ref.member}' takes no arguments", None)
+            self._bindings[key] = found
+        return self._bindings[key]
 
     def count_shape(self, module, pos) -> None:
         self.shapes += 1
@@ -170,6 +187,17 @@ class Application:
         self.ctx = Context(shape, args, Stream(shape.hash), engine.seed, indices[:2], indices[2:])
         self.children: list = []
         self.counter = 0
+        if len(args) != len(rule.params):
+            self.fill_defaults(args)
+
+    def fill_defaults(self, args: dict) -> None:
+        """Parameters the caller left out take their defaults, evaluated in order in the rule's
+        own module on the shape it received (a default may use the parameters before it)."""
+        rule = self.rule
+        for i, p in enumerate(rule.params):
+            if p not in args:
+                fn = self.engine.compiled(self.compiler, rule.default(i), frozenset(rule.params[:i]))
+                args[p] = fn(self.ctx)
 
     def value(self, node):
         return self.engine.compiled(self.compiler, node, self.local)(self.ctx)
@@ -271,8 +299,14 @@ class Application:
         return out
 
     def successor(self, shape: Shape, step: n.Successor, handover: bool = False) -> None:
-        module, member = self.module.lookup_module(step.name)
-        args = [self.value(a.expr if isinstance(a, n.Relative) else a) for a in step.args]
+        if step.name in self.local:  # a rule handed over in a parameter
+            module, member = self.target(step)
+        else:
+            module, member = self.module.lookup_module(step.name)
+        if step.args:
+            args = self.bind(module, member, step)
+        else:
+            args = {}
         child = shape if handover else shape.copy()
         index = self.counter
         self.counter += 1
@@ -291,8 +325,38 @@ class Application:
             return
         rule = module.rules[member]
         ctx = self.ctx
-        self.children.append((child, module, rule, dict(zip(rule.params, args)),
+        self.children.append((child, module, rule, args,
                               (ctx.split_index, ctx.split_total, ctx.comp_index, ctx.comp_total)))
+
+    def target(self, step: n.Successor):
+        """The (module, rule name) a parameter used as a successor holds."""
+        ref = self.ctx.args[step.name]
+        if not isinstance(ref, RuleRef):
+            shown = f'the string "{ref}"' if isinstance(ref, str) else f"the value {ref:g}" if isinstance(
+                ref, float) else repr(ref)
+            raise runtime_error(self.module, step.pos,
+                                f"parameter '{step.name}' is applied as a rule but holds {shown}",
+                                f"pass a rule: {self.rule.name}({step.name} = SomeRule)")
+        if step.args or ref.member in ref.module.rules:
+            problem = self.engine.binding_problem(ref, step)
+            if problem is not None:
+                raise runtime_error(self.module, step.pos, problem[1] + f" (held by parameter '{step.name}')",
+                                    problem[2])
+        return ref.module, ref.member
+
+    def bind(self, module, member: str, step: n.Successor) -> dict:
+        """Argument values by parameter name: positions first, then keywords (the checker, or
+        target() for a rule held in a parameter, has made sure they fit)."""
+        if member not in module.rules:
+            return {}
+        out = {}
+        params = module.rules[member].params
+        for i, arg in enumerate(step.args):
+            if isinstance(arg, n.Keyword):
+                out[arg.name] = self.value(arg.value)
+            else:
+                out[params[i]] = self.value(arg.expr if isinstance(arg, n.Relative) else arg)
+        return out
 
     def piece(self, shape: Shape, body: n.Sequence, split=None, comp=None) -> None:
         """Run a block entry's steps on one piece (a split piece, a face, an inset)."""

@@ -42,6 +42,27 @@ class Context:
         self.comp_index, self.comp_total = comp
 
 
+class RuleRef:
+    """A rule or terminal handed to a rule parameter as a value (``Facade(window = win.Arched)``).
+
+    It names the module that defines the rule, so a stdlib façade applies the caller's window.
+    """
+
+    __slots__ = ("module", "member")
+
+    def __init__(self, module, member: str) -> None:
+        self.module, self.member = module, member
+
+    def __eq__(self, other) -> bool:
+        return isinstance(other, RuleRef) and other.module is self.module and other.member == self.member
+
+    def __hash__(self) -> int:
+        return hash((id(self.module), self.member))
+
+    def __repr__(self) -> str:
+        return f"the rule '{self.member}'"
+
+
 def _num(module, pos, value, what="a number"):
     if isinstance(value, bool) or not isinstance(value, (int, float)):
         raise runtime_error(module, pos, f"expected {what}, got {_show(value)}")
@@ -53,7 +74,7 @@ def _show(value) -> str:
         return "true" if value else "false"
     if isinstance(value, str):
         return f'the string "{value}"'
-    return repr(value)
+    return repr(value)  # numbers, and RuleRef: "the rule 'Arched'"
 
 
 _ARITH = {"+": operator.add, "-": operator.sub, "*": operator.mul, "/": operator.truediv,
@@ -109,6 +130,10 @@ class Compiler:
             return lambda ctx: ctx.shape.depth
         if name == "seed":
             return lambda ctx: ctx.seed
+        module, member = self.module.lookup_module(name)
+        if member in module.rules or member in module.terminals:
+            ref = RuleRef(module, member)
+            return lambda ctx: ref
         alias, member = name.split(".", 1)
         other = self.modules[id(self.module.imports[alias])]
         values = other.values

@@ -33,7 +33,7 @@ CASES = [
     pytest.param("A --> extrude(scope.sw)\n", 1, 15, "unknown name 'scope.sw'", "did you mean 'scope.s",
                  id="unknown-scope-member"),
     pytest.param("A --> extrude(B)\nB --> NIL\n", 1, 15, "'B' is a rule, not a value",
-                 "rules are applied in a rule body", id="rule-used-as-value"),
+                 "handed whole to a rule parameter", id="rule-used-as-value"),
     pytest.param("func storeys(h) = h / 3\nLot --> extrude(storys(9))\n", 2, 17,
                  "unknown function 'storys'", "did you mean 'storeys'?", id="unknown-function"),
     pytest.param("A --> extrude(extrude(1))\n", 1, 15, "'extrude' is an operation, not a function", None,

@@ -112,3 +112,32 @@ def signed_area(ring) -> float:
     for (x0, y0), (x1, y1) in zip(ring, ring[1:] + ring[:1]):
         a += x0 * y1 - x1 * y0
     return a / 2.0
+
+
+def named_footprint(kind: str, a: float, b: float) -> list[Poly]:
+    """A building outline in the unit square, counter-clockwise, its first edge on the front (v = 0).
+
+    ``a`` and ``b`` are wing widths as fractions of the scope (``a`` along u, ``b`` along v);
+    for ``circle`` ``a`` is the number of sides, the first side centred on the front so that
+    ``comp(f) { front: ... }`` finds it.  The caller has checked the ranges.
+    """
+    if kind == "rect":
+        ring = UNIT_SQUARE
+    elif kind == "L":  # a bar along the front, a wing up the left side
+        ring = ((0, 0), (1, 0), (1, b), (a, b), (a, 1), (0, 1))
+    elif kind == "U":  # a bar along the front, wings up both sides, open at the back
+        ring = ((0, 0), (1, 0), (1, 1), (1 - a, 1), (1 - a, b), (a, b), (a, 1), (0, 1))
+    elif kind == "T":  # a bar along the front, a centred wing to the back
+        lo, hi = 0.5 - a / 2, 0.5 + a / 2
+        ring = ((0, 0), (1, 0), (1, b), (hi, b), (hi, 1), (lo, 1), (lo, b), (0, b))
+    elif kind == "cross":  # a centred bar each way
+        ulo, uhi, vlo, vhi = 0.5 - a / 2, 0.5 + a / 2, 0.5 - b / 2, 0.5 + b / 2
+        ring = ((ulo, 0), (uhi, 0), (uhi, vlo), (1, vlo), (1, vhi), (uhi, vhi), (uhi, 1), (ulo, 1),
+                (ulo, vhi), (0, vhi), (0, vlo), (ulo, vlo))
+    elif kind == "circle":
+        n = int(a)
+        angles = -np.pi / 2 - np.pi / n + 2 * np.pi * np.arange(n) / n
+        ring = tuple(zip((0.5 + 0.5 * np.cos(angles)).tolist(), (0.5 + 0.5 * np.sin(angles)).tolist()))
+    else:
+        raise ValueError(f"unknown footprint {kind!r}")
+    return [(tuple((float(u), float(v)) for u, v in ring), ())]

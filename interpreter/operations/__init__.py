@@ -13,6 +13,7 @@ IMPLEMENTATIONS = {
     "center": transforms.center, "matrix": transforms.matrix,
     "split": splits.split,
     "comp": components.comp, "offset": components.offset, "extrude": components.extrude,
+    "footprint": components.footprint,
     "taper": components.taper,
     "roof": roofs.roof,
     "i": inserts.insert,

@@ -8,7 +8,8 @@ from bgr.grammar import nodes as n
 
 from ..expressions import runtime_error
 from ..geometry.meshes import PLANE_AXES
-from ..geometry.polygons import RECT, UNIT_SQUARE, inset, is_unit_square, normalise as normalise_polys, signed_area
+from ..geometry.polygons import (RECT, UNIT_SQUARE, inset, is_unit_square, named_footprint,
+                                 normalise as normalise_polys, signed_area)
 from ..shapes import Flat, Prism, Solid, cross, dot, normalise
 from ..terminals import UnitMesh
 
@@ -163,6 +164,31 @@ def _height(app, step, value) -> float:
         raise runtime_error(app.module, step.pos, f"negative height {value:g} in {step.name}()",
                             "heights are lengths; use r() to turn a shape over")
     return float(value)
+
+
+def footprint(app, shape, step, args) -> bool:
+    """Swap a 2D shape's outline for a named footprint (L, U, T, cross, circle) in its scope."""
+    geom = _flat(app, step, shape)
+    kind, a, b = args[0], args[1], args[2]
+    for name, value in (("a", a), ("b", b)):
+        if isinstance(value, bool) or not isinstance(value, (int, float)):
+            raise runtime_error(app.module, step.pos, f"footprint() needs a number for {name}, got {value!r}")
+    if kind == "circle":
+        sides = 24 if len(step.args) < 2 else a
+        if sides != int(sides) or not 3 <= sides <= 1024:
+            raise runtime_error(app.module, step.pos, f"a circle footprint needs 3 to 1024 sides, got {sides:g}")
+        a = sides
+    else:
+        b = a if len(step.args) < 3 else b
+        most = 0.5 if kind == "U" else 1.0  # U's two wings must not meet
+        for name, value in (("a", a), ("b", b)):
+            if kind != "rect" and not 0 < value < most:
+                raise runtime_error(app.module, step.pos,
+                                    f"footprint({kind}) needs 0 < {name} < {most:g} (a fraction of the scope), "
+                                    f"got {value:g}")
+    polys = named_footprint(kind, a, b)
+    shape.geom = Flat(geom.k, RECT if kind == "rect" else polys)
+    return False
 
 
 def extrude(app, shape, step, args) -> bool:
