@@ -180,8 +180,8 @@ def footprint(app, shape, step, args) -> bool:
         a = sides
     else:
         b = a if len(step.args) < 3 else b
-        most = 0.5 if kind == "U" else 1.0  # U's two wings must not meet
         for name, value in (("a", a), ("b", b)):
+            most = 0.5 if kind == "U" and name == "a" else 1.0  # U's two wings must not meet
             if kind != "rect" and not 0 < value < most:
                 raise runtime_error(app.module, step.pos,
                                     f"footprint({kind}) needs 0 < {name} < {most:g} (a fraction of the scope), "
