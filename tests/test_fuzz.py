@@ -354,7 +354,18 @@ class _Gen:
         name, count = self.pick(targets)
         if count == 0:
             return [name] + (["(", ")"] if self.chance(0.1) else [])
-        return [name] + self.args([self.num(ctx["names"], ctx["funcs"], depth=1) for _ in range(count)])
+        required = count - ctx["defaults"].get(name, 0)
+        given = required + self.d(st.integers(0, count - required))
+        args = [self.num(ctx["names"], ctx["funcs"], depth=1) for _ in range(given)]
+        if given > required and self.chance(0.5):  # the optional ones by name, in any order
+            optional = [[f"p{j}", "="] + a for j, a in zip(range(required, given), args[required:])]
+            args = args[:required] + self.rng_shuffled(optional)
+        if not args:
+            return [name] + (["(", ")"] if self.chance(0.3) else [])
+        return [name] + self.args(args)
+
+    def rng_shuffled(self, items):
+        return self.d(st.permutations(items)) if items else items
 
     def step(self, ctx, depth):
         kind = self.pick(["op", "op", "succ", "succ", "push", "nil"])
@@ -418,6 +429,7 @@ class _Gen:
         terminals = [f"W{i}" for i in range(self.d(st.integers(0, 3)))]
         funcs = {f"f{i}": self.d(st.integers(0, 2)) for i in range(n_funcs)}
         rules = {f"R{i}": self.d(st.integers(0, 2)) for i in range(n_rules)}
+        defaults = {r: self.d(st.integers(0, c)) for r, c in rules.items()}  # the last k have defaults
         items = []
         if self.chance(0.5):
             items.append(["version", "1"])
@@ -436,12 +448,24 @@ class _Gen:
             items.append(["asset", a, "=", f'"assets/{a}.glb"'])
         if terminals:
             items.append(["terminal"] + _commas(terminals))
-        ctx = {"rules": rules, "terminals": terminals, "funcs": funcs, "assets": assets, "palette": palette}
+        ctx = {"rules": rules, "terminals": terminals, "funcs": funcs, "assets": assets, "palette": palette,
+               "defaults": defaults}
         for rname, count in rules.items():
             params = [f"p{j}" for j in range(count)]
             ctx["names"] = params + values + ["scope.sx", "scope.sy", "scope.z", "split.index", "split.total",
                                              "comp.index", "depth", "seed"]
-            head = [rname] + (["("] + _commas(params) + [")"] if params or self.chance(0.1) else [])
+            declared = []
+            for j, p in enumerate(params):
+                if j >= count - defaults[rname]:  # a simple default: a number or an earlier name
+                    choices = params[:j] + values + ["scope.sx"]
+                    value = self.number() if not choices or self.chance(0.5) else self.pick(choices)
+                    declared.append([p, "=", value])
+                else:
+                    declared.append([p])
+            inner = []
+            for j, part in enumerate(declared):
+                inner += ([","] if j else []) + part
+            head = [rname] + (["("] + inner + [")"] if params or self.chance(0.1) else [])
             # a rule's head (name, parameters, arrow) holds no comments: see bgr.lark's RULE_NAME
             items.append([_QUIET] + head + ["-->", _LOUD] + self.body(ctx))
         if self.chance(0.3):
