@@ -461,6 +461,10 @@ class Checker:
                     self.error(e.pos, f"'{name}' is a rule, not a value",
                                "a rule can only be handed whole to a rule parameter: R(part = Name)")
                     return
+                if member[:1].isupper():  # most likely a rule handed to a parameter
+                    hint = suggest(member, list(module.rules) + list(module.terminals))
+                    self.error(e.pos, f"module '{alias}' has no rule '{member}'", hint)
+                    return
                 hint = suggest(member, list(module.attrs) + list(module.consts))
                 self.error(e.pos, f"module '{alias}' has no attr or const '{member}'", hint)
                 return

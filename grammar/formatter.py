@@ -6,6 +6,7 @@ Layout rules (docs/language.md, "Formatting"):
 * a rule is one line when it fits in 100 columns; otherwise, or when a comment sits inside it,
   its stochastic or conditional branches go one per line, and its split / comp / offset blocks
   open with ``{`` and put one entry per line, each after a leading ``|``;
+* a rule head longer than 60 columns puts one parameter per line, then ``) -->`` and the body;
 * spacing is fixed: ``a + b``, ``f(a, b)``, ``{ 3: A | ~1: B }``, ``[ t(0, 0, 1) A ]``;
 * expressions get the parentheses their meaning needs and no more.
 
@@ -24,6 +25,7 @@ from . import nodes as n
 from .errors import BgrError, Diagnostic, source_lines
 
 WIDTH = 100
+HEAD_WIDTH = 60  # a rule head (name, parameters, arrow) longer than this lists one parameter per line
 INDENT = "    "
 
 # Precedence levels, loosest first; they mirror the tree builder's binding powers.
@@ -224,6 +226,14 @@ class Formatter:
 
     def rule(self, rule: n.Rule, out: _Writer) -> None:
         head = rule.name + format_params(rule) + " -->"
+        if len(head) > HEAD_WIDTH:  # a long parameter list: one parameter per line
+            out.write(rule.name + "(")
+            for i, p in enumerate(rule.params):
+                out.start(rule.pos.line, 1)
+                d = rule.default(i)
+                out.write((p if d is None else f"{p} = {format_expr(d)}") + ("," if i < len(rule.params) - 1 else ""))
+            out.start(rule.pos.line, 0)
+            head = ") -->"
         body = rule.body
         if isinstance(body, n.Sequence):
             out.write(head + " ")

@@ -75,6 +75,8 @@ def test_layout_round_trip(src):
     ("Lot --> extrude(B)\nB --> NIL\n", 1, 17, "'B' is a rule, not a value", "R(part = Name)"),
     ("Lot --> A(x = B + 1)\nA(x = 0) --> NIL\nB --> NIL\n", 1, 15, "'B' is a rule, not a value", None),
     ("Lot --> footprint(Q)\n", 1, 19, "unknown footprint kind 'Q'", "rect, L, U"),
+    ("import stdlib.palette as pal\nLot --> A\nA(c = pal.Brick) --> NIL\n", 3, 7, "module 'pal' has no rule 'Brick'",
+     None),
 ])
 def test_check_errors(src, line, column, message, hint):
     check(src, line, column, message, hint)
