@@ -153,7 +153,10 @@ class Engine:
     def mesh_id(self, geom) -> int:
         if isinstance(geom, Solid):
             return geom.mesh
-        key = (type(geom).__name__, geom.k, geom.polys if geom.polys == RECT else id(geom))
+        # equal outlines share one unit mesh: a window's frame ring, cut to the same size on
+        # every floor, is built once and instanced
+        polys = geom.polys if geom.polys == RECT else tuple(geom.polys)
+        key = (type(geom).__name__, geom.k, geom.name, polys)
         found = self._flat_ids.get(key)
         if found is not None:
             return found
@@ -161,9 +164,7 @@ class Engine:
             verts, faces = meshes.flat_mesh(geom.polys, geom.k)
         else:
             verts, faces = meshes.prism_mesh(geom.polys, geom.k)
-        found = self.table.library.add(UnitMesh(geom.name, verts, faces))
-        if geom.polys == RECT:
-            self._flat_ids[key] = found
+        found = self._flat_ids[key] = self.table.library.add(UnitMesh(geom.name, verts, faces))
         return found
 
     def primitive_id(self, name: str) -> int:
