@@ -16,7 +16,7 @@ import traceback
 from pathlib import Path
 
 from . import __version__
-from .grammar.errors import BgrError
+from .grammar.errors import BgrError, Diagnostic
 from .grammar.formatter import format_module
 from .grammar.loader import decode, load, read_source
 from .grammar.parser import parse
@@ -58,6 +58,28 @@ def build_parser() -> argparse.ArgumentParser:
                         help="the lot: width,depth in metres (default 20,20) or GeoJSON footprints")
     derive.add_argument("--max-depth", type=int, default=256, metavar="N", help="rule depth limit (256)")
     derive.add_argument("--max-shapes", type=int, default=10_000_000, metavar="N",
+                        help="shape budget (10,000,000)")
+
+    render = commands.add_parser("render", help="draw a grammar or a model into a PNG preview",
+                                 description="Derive FILE.bgr (or read FILE.glb / FILE.gltf) and draw it "
+                                 "headless into a PNG: shaded, silhouette, lines or labels.")
+    render.add_argument("file", metavar="FILE.bgr|FILE.glb")
+    render.add_argument("-o", "--output", metavar="OUT.png", help="the PNG to write")
+    render.add_argument("--mode", choices=["shaded", "silhouette", "lines", "labels"], default="shaded",
+                        help="what to draw (default shaded)")
+    render.add_argument("--view", default="iso", metavar="front|iso|top|CAMERA.json",
+                        help="a view fitted to the model (default iso) or a camera file")
+    render.add_argument("--size", metavar="WxH", help="image size in pixels (default 1024x768, or the camera file's)")
+    render.add_argument("--backend", choices=["auto", "gl", "numpy"], default="auto",
+                        help="rasteriser: OpenGL (EGL), numpy, or auto: GL when it can (default)")
+    render.add_argument("--legend", action="store_true",
+                        help="with --mode labels: also write OUT.legend.json (label -> colour)")
+    render.add_argument("--seed", type=int, default=None, help="global random seed for a .bgr (default 0)")
+    render.add_argument("--set", action="append", default=[], metavar="NAME=VALUE",
+                        help="override an attr of a .bgr; repeatable")
+    render.add_argument("--lot", metavar="W,D|LOTS.geojson", help="the lot of a .bgr, as for derive")
+    render.add_argument("--max-depth", type=int, default=256, metavar="N", help="rule depth limit (256)")
+    render.add_argument("--max-shapes", type=int, default=10_000_000, metavar="N",
                         help="shape budget (10,000,000)")
 
     fmt = commands.add_parser("fmt", help="print files in the canonical layout",
@@ -181,7 +203,78 @@ def cmd_derive(args) -> int:
     return EXIT_OK
 
 
-COMMANDS = {"check": cmd_check, "fmt": cmd_fmt, "derive": cmd_derive}
+def _parse_size(text: str) -> tuple[int, int] | None:
+    width, sep, height = text.lower().partition("x")
+    if sep and width.strip().isdigit() and height.strip().isdigit():
+        size = int(width), int(height)
+        if 1 <= size[0] <= 16384 and 1 <= size[1] <= 16384:
+            return size
+    return None
+
+
+def cmd_render(args) -> int:
+    from .render import (
+        VIEWS,
+        image_of,
+        legend_path,
+        load_scene,
+        make_camera,
+        rasterise,
+        save_legend,
+        save_png,
+    )
+
+    def usage(message: str) -> int:
+        print(f"bgr render: {message}", file=sys.stderr)
+        return EXIT_USAGE
+
+    if args.output in (None, "-"):
+        return usage("give the output file with -o OUT.png")
+    size = None
+    if args.size is not None:
+        size = _parse_size(args.size)
+        if size is None:
+            return usage(f"--size {args.size}: write WIDTHxHEIGHT, e.g. 1024x768 (1 to 16384 pixels each)")
+    if args.view not in VIEWS and not args.view.lower().endswith(".json"):
+        return usage(f"--view {args.view}: give {', '.join(VIEWS)} or a camera file CAMERA.json")
+    if args.legend and args.mode != "labels":
+        return usage("--legend goes with --mode labels")
+    is_grammar = Path(args.file).suffix.lower() == ".bgr"
+    if not is_grammar and (args.seed is not None or args.set or args.lot is not None):
+        return usage("--seed, --set and --lot apply to a .bgr grammar, not to a model file")
+    if args.max_depth < 1 or args.max_shapes < 1:
+        return usage("--max-depth and --max-shapes must be positive")
+    attrs = {}
+    for item in args.set:
+        name, sep, value = item.partition("=")
+        if not sep or not name.strip():
+            return usage(f"--set {item}: write NAME=VALUE")
+        attrs[name.strip()] = _parse_value(value.strip())
+    out = Path(args.output)
+    if out.suffix.lower() != ".png":  # before deriving: a typo should not cost a derivation
+        shown = f"unknown output extension '{out.suffix}'" if out.suffix else "the output file name has no extension"
+        raise BgrError(Diagnostic(args.output, 0, 0, shown, "bgr render writes .png files"))
+
+    scene = load_scene(args.file, seed=args.seed or 0, attrs=attrs, lot=args.lot,
+                       max_depth=args.max_depth, max_shapes=args.max_shapes)
+    camera = make_camera(args.view, scene, size)
+
+    def fallback(reason: str) -> None:
+        print(f"bgr render: {reason}; using the numpy renderer (slower)", file=sys.stderr)
+
+    frame = rasterise(scene, camera, args.backend, on_fallback=fallback)
+    image, legend = image_of(frame, scene, args.mode)
+    save_png(image, out)
+    if args.legend and legend is not None:
+        save_legend(legend, legend_path(out))
+    width, height = camera.size
+    view = args.view if args.view in VIEWS else Path(args.view).name
+    print(f"{args.output}: {width}x{height} {args.mode}, view {view}, {len(scene):,} triangles ({frame.backend})",
+          file=sys.stderr)
+    return EXIT_OK
+
+
+COMMANDS = {"check": cmd_check, "fmt": cmd_fmt, "derive": cmd_derive, "render": cmd_render}
 
 
 def main(argv: list[str] | None = None) -> int:

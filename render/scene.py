@@ -1,0 +1,188 @@
+"""What the renderer draws: world triangles with a colour, a part and a label each.
+
+Every source (a derivation ``Result``, a ``.bgr`` file, a ``.glb``/``.gltf`` file, a trimesh) is
+turned into one :class:`Scene` so that the rasterisers and the image modes never care where the
+triangles came from.
+
+* ``part`` says where a triangle came from: the row of its terminal in the derivation's terminal
+  table (so a pixel's triangle leads to the terminal's path, rule and scope), or its material's
+  index for a glTF file, which keeps no terminals (-1: no material), or its colour's index for
+  a bare trimesh.
+* ``label`` is what the ``labels`` mode colours by.  For a derivation it is the terminal's label
+  (``label()`` in the grammar, else its rule name).  A glTF file written by bgr keeps materials
+  but not terminal labels, so its triangles are labelled by material: the ``material()`` name
+  when the grammar gave one, else the colour as ``#rrggbb``.  A foreign glTF file is labelled the
+  same way, by its materials' names (or colours, for unnamed materials); triangles without any
+  material get the label ``(none)``.  For exact terminal labels, render the ``.bgr`` itself.
+"""
+
+from __future__ import annotations
+
+import os
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from ..grammar.errors import BgrError, Diagnostic
+
+NO_LABEL = "(none)"
+
+
+@dataclass(eq=False)
+class Scene:
+    """Triangles in world space (y up) and, per triangle, its colour, part and label."""
+
+    triangles: np.ndarray  # (T, 3, 3) float64, corners counter-clockwise seen from outside
+    colors: np.ndarray  # (T, 3) uint8 sRGB
+    part: np.ndarray  # (T,) int64
+    label: np.ndarray  # (T,) int64 index into labels
+    labels: list[str]
+
+    def __len__(self) -> int:
+        return len(self.triangles)
+
+    def bounds(self) -> tuple[np.ndarray, np.ndarray]:
+        """(lo, hi) corners of the axis-aligned bounding box (a unit box at 0 when empty)."""
+        if len(self) == 0:
+            return np.full(3, -0.5), np.full(3, 0.5)
+        flat = self.triangles.reshape(-1, 3)
+        return flat.min(axis=0), flat.max(axis=0)
+
+    def normals(self) -> np.ndarray:
+        """(T, 3) unit face normals (degenerate triangles get +y)."""
+        t = self.triangles
+        n = np.cross(t[:, 1] - t[:, 0], t[:, 2] - t[:, 0])
+        length = np.linalg.norm(n, axis=1)
+        bad = ~(length > 0)
+        n[bad], length[bad] = (0.0, 1.0, 0.0), 1.0
+        return n / length[:, None]
+
+
+def _labels_index(names) -> tuple[np.ndarray, list[str]]:
+    labels, index = np.unique(np.asarray(list(names), dtype=object).astype(str), return_inverse=True)
+    return index.reshape(-1).astype(np.int64), [str(s) for s in labels]
+
+
+def from_result(result: Any) -> Scene:
+    """A derivation's terminals: part = terminal row, label = terminal label."""
+    from ..interpreter.writers.meshes import bake, srgb8
+
+    table = result.terminals if hasattr(result, "terminals") else result
+    table.freeze()
+    baked = bake(table)
+    row = np.repeat(np.arange(len(table), dtype=np.int64), np.diff(baked.fstart))
+    label_of_row, labels = _labels_index(table.label) if len(table) else (np.zeros(0, np.int64), [])
+    return Scene(triangles=baked.vertices[baked.faces], colors=srgb8(table)[row], part=row,
+                 label=label_of_row[row], labels=labels)
+
+
+def from_trimesh(mesh: Any, material_names: list[str] | None = None,
+                 material_of_face: np.ndarray | None = None) -> Scene:
+    """A trimesh: colours from its face colours; parts and labels by material when known, else
+    by colour."""
+    faces = np.asarray(mesh.faces, dtype=np.int64).reshape(-1, 3)
+    triangles = np.asarray(mesh.vertices, dtype=np.float64)[faces] if len(faces) else np.zeros((0, 3, 3))
+    try:
+        rgb = np.asarray(mesh.visual.face_colors, dtype=np.uint8)[:, :3]
+    except Exception:  # noqa: BLE001  # pragma: no cover - a visual that has no face colours
+        rgb = np.full((len(faces), 3), 200, dtype=np.uint8)
+    if len(rgb) != len(faces):
+        rgb = np.full((len(faces), 3), 200, dtype=np.uint8)
+    if material_of_face is not None and material_names is not None and len(material_of_face) == len(faces):
+        names = [NO_LABEL if m < 0 else material_names[m] for m in range(-1, len(material_names))]
+        label, labels = _labels_index(names[m + 1] for m in material_of_face)
+        part = material_of_face.astype(np.int64)
+    else:
+        packed = (rgb[:, 0].astype(np.int64) << 16) | (rgb[:, 1].astype(np.int64) << 8) | rgb[:, 2]
+        _, part = np.unique(packed, return_inverse=True)
+        label, labels = _labels_index(f"#{p:06x}" for p in packed)
+        part = part.reshape(-1).astype(np.int64)
+    return Scene(triangles=triangles, colors=rgb.copy(), part=part, label=label, labels=labels)
+
+
+def _glb_materials(gltf: dict) -> tuple[list[str], np.ndarray]:
+    """(material names, material index of each face) in the order ``read_glb`` emits faces.
+
+    ``read_glb`` keeps no material per face, so this walks the same nodes, instances and
+    primitives in the same order, counting faces from the accessors' ``count`` alone.
+    """
+    nodes, meshes = gltf.get("nodes", []), gltf.get("meshes", [])
+    names = []
+    for k, mat in enumerate(gltf.get("materials", [])):
+        extras = mat.get("extras") if isinstance(mat.get("extras"), dict) else {}
+        names.append(extras.get("material") or mat.get("name") or extras.get("color") or f"material {k}")
+    out: list[np.ndarray] = []
+
+    def visit(index: int) -> None:
+        node = nodes[index]
+        if "mesh" in node:
+            inst = node.get("extensions", {}).get("EXT_mesh_gpu_instancing")
+            copies = gltf["accessors"][next(iter(inst["attributes"].values()))]["count"] if inst else 1
+            for prim in meshes[node["mesh"]]["primitives"]:
+                if prim.get("mode", 4) != 4:
+                    continue
+                source = prim["indices"] if "indices" in prim else prim["attributes"]["POSITION"]
+                n = gltf["accessors"][source]["count"] // 3 * copies
+                out.append(np.full(n, prim.get("material", -1), dtype=np.int64))
+        for child in node.get("children", []):
+            visit(child)
+
+    if gltf.get("scenes"):
+        roots = gltf["scenes"][gltf.get("scene", 0)].get("nodes", [])
+    else:
+        children = {c for node in nodes for c in node.get("children", [])}
+        roots = [i for i in range(len(nodes)) if i not in children]
+    for root in roots:
+        visit(root)
+    return names, (np.concatenate(out) if out else np.zeros(0, dtype=np.int64))
+
+
+def from_gltf(path: str | os.PathLike) -> Scene:
+    """A .glb or .gltf file, instances expanded (``read_glb``); parts and labels by material."""
+    from ..interpreter.writers.glb_read import parse, read_glb
+
+    shown = str(path)
+    try:
+        data = Path(path).read_bytes()
+        gltf, _ = parse(data)
+        mesh = read_glb(path)
+        names, material = _glb_materials(gltf)
+    except FileNotFoundError:
+        raise BgrError(Diagnostic(shown, 0, 0, "no such file", "check the path")) from None
+    except BgrError as exc:
+        raise BgrError(Diagnostic(shown, 0, 0, exc.message, exc.hint)) from None
+    except OSError as exc:
+        raise BgrError(Diagnostic(shown, 0, 0, f"cannot read the file: {exc.strerror or exc}")) from None
+    except (ValueError, KeyError, IndexError, TypeError, AttributeError, StopIteration) as exc:
+        raise BgrError(Diagnostic(shown, 0, 0, f"not a glTF 2.0 file bgr can read ({type(exc).__name__}: {exc})",
+                                  "bgr reads triangle meshes with float positions")) from None
+    return from_trimesh(mesh, names, material)
+
+
+def load_scene(source: Any, *, seed: int = 0, attrs: dict | None = None, lot: Any = None,
+               max_depth: int | None = None, max_shapes: int | None = None) -> Scene:
+    """A :class:`Scene` from a Scene, a ``bgr.Result``, a terminal table, a trimesh, or a path to
+    a ``.bgr`` (derived with ``seed``, ``attrs`` and ``lot``), ``.glb`` or ``.gltf`` file."""
+    if isinstance(source, Scene):
+        return source
+    if isinstance(source, (str, os.PathLike)):
+        path = Path(source)
+        suffix = path.suffix.lower()
+        if suffix == ".bgr":
+            from ..grammar.loader import load
+            from ..interpreter.derive import derive
+
+            limits = {k: v for k, v in (("max_depth", max_depth), ("max_shapes", max_shapes)) if v is not None}
+            grammar = load(path, path=str(source))
+            return from_result(derive(grammar, seed=seed, attrs=attrs, lot=lot, **limits))
+        if suffix in (".glb", ".gltf"):
+            return from_gltf(path)
+        raise BgrError(Diagnostic(str(source), 0, 0, f"cannot render a '{suffix or 'extensionless'}' file",
+                                  "give a .bgr grammar or a .glb/.gltf model"))
+    if hasattr(source, "terminals") or hasattr(source, "library"):
+        return from_result(source)
+    if hasattr(source, "vertices") and hasattr(source, "faces"):
+        return from_trimesh(source)
+    raise BgrError(f"cannot render a {type(source).__name__}; give a bgr Result, a trimesh or a file path")
