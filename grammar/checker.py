@@ -244,6 +244,12 @@ class Checker:
                 self.arg(arg, local, relative_ok=False)
         if step.name in local:  # a parameter that holds a rule: checked when it is applied
             return
+        keyword = next((a for a in step.args if isinstance(a, n.Keyword)), None)
+        if step.name in OPERATIONS and keyword is not None:  # `extrude(h = 3)`: left to us by the parser
+            self.error(keyword.pos, f"operation '{step.name}' takes no keyword arguments",
+                       f"write the value alone, without '{keyword.name} =' (or, if '{step.name}' is a "
+                       "parameter holding a rule, declare it in the rule's head)", len(keyword.name))
+            return
         module, member = self.g.lookup_module(step.name)
         if module is not self.g or "." in step.name:
             alias = step.name.split(".", 1)[0]

@@ -215,13 +215,15 @@ class _TreeBuilder(Transformer):
     def call(self, c):
         name, args, block = str(c[0]), c[1] or [], c[2]
         _keywords_last(args)
-        if name in OPERATIONS:
-            _no_keywords(args, f"operation '{name}'")
+        keywords = any(isinstance(a, n.Keyword) for a in args)
+        if name in OPERATIONS and not (keywords and block is None):
             return n.Operation(name, args, block, pos=_span(c))
         if block is not None:
             hint = suggest(name, [op for op, spec in OPERATIONS.items() if spec.block])
             raise _Problem(_tok_pos(c[0]), f"unknown operation '{name}' with a {{ }} block",
                            hint or "only split, comp and offset take a { } block", len(name))
+        # keyword arguments make it a rule application (operations take none): a parameter named
+        # like an operation (`roof(pitch = 20)` with a parameter `roof`); the checker decides
         return n.Successor(name, args, pos=_span(c))
 
     def block(self, c):

@@ -125,6 +125,14 @@ def test_a_held_rule_the_arguments_do_not_fit_is_a_runtime_error():
         derive("Lot --> A(B)\nA(p) --> p\nB(h) --> NIL\n")
 
 
+def test_a_parameter_named_like_an_operation_applies_its_rule_with_keywords():
+    """`roof(pitch = 30)` with a parameter `roof` is the held rule; `roof(hip, 30)` the operation."""
+    src = ("Lot(roof = Gable) --> extrude(5) comp(f) { top: roof(pitch = 30) | all: NIL }\n"
+           "Gable(pitch = 10) --> s(1, pitch, 1) X\nterminal X\n")
+    t = derive(src)
+    assert t.label == ["X"] and t.size[0][1] == pytest.approx(30)
+
+
 def test_a_held_rule_takes_keyword_arguments():
     src = "Lot --> A(B)\nA(p) --> p(h = 4)\nB(w = 1, h = 1) --> s(w, h, 1) X\nterminal X\n"
     np.testing.assert_allclose(derive(src).size[0], [1, 4, 1])
