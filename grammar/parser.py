@@ -504,7 +504,9 @@ def _translate(e: UnexpectedInput, text: str, path: str) -> BgrSyntaxError:
         return BgrSyntaxError(Diagnostic(path, line, column, message, hint, source_line(text, line)))
     tok = getattr(e, "token", None)
     expected = set(getattr(e, "accepts", None) or getattr(e, "expected", None) or ())
-    special = _arrow_mistake(tok, text, path) if tok is not None and tok.type != "$END" else None
+    special = _deep_default(text, path)
+    if special is None and tok is not None and tok.type != "$END":
+        special = _arrow_mistake(tok, text, path)
     if special is not None:
         return special
     if isinstance(e, UnexpectedEOF) or (tok is not None and tok.type == "$END"):
@@ -524,6 +526,44 @@ def _translate(e: UnexpectedInput, text: str, path: str) -> BgrSyntaxError:
 
 def _line_col(text: str, index: int) -> tuple[int, int]:
     return text.count("\n", 0, index) + 1, index - (text.rfind("\n", 0, index) + 1) + 1
+
+
+def _deep_default(text: str, path: str) -> BgrSyntaxError | None:
+    """A rule head whose defaults nest parentheses two levels deep, `A(x = max(0, min(1, 2))) -->`:
+    the lexer's rule-head look-ahead allows one level, so the head is not recognised and the error
+    would otherwise land somewhere puzzling."""
+    at = text.find("-->")
+    while at != -1:
+        if "#" in text[text.rfind("\n", 0, at) + 1:at]:  # an arrow in a comment
+            at = text.find("-->", at + 3)
+            continue
+        i = at - 1
+        while i >= 0 and text[i] in " \t\r\n":
+            i -= 1
+        if i >= 0 and text[i] == ")":
+            depth = deepest = 0
+            while i >= 0:
+                if text[i] == ")":
+                    depth += 1
+                    deepest = max(deepest, depth)
+                elif text[i] == "(":
+                    depth -= 1
+                    if depth == 0:
+                        break
+                elif text[i] in "\n#" and depth == 0:
+                    break
+                i -= 1
+            j = i - 1
+            while j >= 0 and (text[j].isalnum() or text[j] == "_"):
+                j -= 1
+            if depth == 0 and deepest > 2 and j + 1 < i:
+                line, col = _line_col(text, j + 1)
+                return BgrSyntaxError(Diagnostic(
+                    path, line, col, "the defaults of this rule nest parentheses more than one level deep",
+                    "move the expression into a func (func f(x) = ...) and call that in the default",
+                    source_line(text, line), i - j - 1))
+        at = text.find("-->", at + 3)
+    return None
 
 
 def _arrow_mistake(tok: Token, text: str, path: str) -> BgrSyntaxError | None:

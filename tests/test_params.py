@@ -82,6 +82,14 @@ def test_check_errors(src, line, column, message, hint):
     check(src, line, column, message, hint)
 
 
+@pytest.mark.parametrize("src, line, column", [
+    ("A(x = max(0, min(1, 2))) --> NIL\n", 1, 1),
+    ("terminal W\nLot --> W\nTile(\n    w = 1,\n    h = max(1, (2 + 3))\n) --> NIL\n", 3, 1),
+])
+def test_defaults_nested_too_deep_are_named(src, line, column):
+    check(src, line, column, "nest parentheses more than one level deep", "func")
+
+
 # ---- rules as parameters ---------------------------------------------------------------------
 
 def test_a_parameter_applies_the_rule_it_holds():
