@@ -177,6 +177,8 @@ BUILTIN_NAMES: dict[str, str] = {
     "split.total": "number of pieces of the enclosing split",
     "comp.index": "0-based index of the face in the enclosing component split",
     "comp.total": "number of faces of the enclosing component split",
+    "comp.left": "the corner at the face's left edge, seen from outside: the angle the wall turns there in degrees (90 at a box's corners, -90 at an inner corner, 0 where the wall runs on or for a top or bottom face)",
+    "comp.right": "the corner at the face's right edge, as comp.left",
     "depth": "derivation depth of the shape", "seed": "the global seed",
 }
 

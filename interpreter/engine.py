@@ -102,7 +102,7 @@ class Engine:
                                 "give the parameters defaults ('w = 10'), or start from a rule that calls this one")
         lot.path = f"{start}.{index}" if several else start
         lot.hash = child_hash(root_hash(self.seed), name_hash(start), index)
-        stack = [(lot, grammar, grammar.rules[start], {}, (0, 1, 0, 1))]
+        stack = [(lot, grammar, grammar.rules[start], {}, (0, 1, 0, 1, 0.0, 0.0))]
         gc_was_on = gc.isenabled()
         gc.disable()  # hundreds of thousands of short-lived shapes and no cycles: measured 15% faster
         try:
@@ -180,7 +180,7 @@ class Application:
     """One rule applied to one shape: runs the body's steps and collects the children."""
 
     def __init__(self, engine: Engine, shape: Shape, module, rule: n.Rule, args: dict,
-                 indices=(0, 1, 0, 1)) -> None:
+                 indices=(0, 1, 0, 1, 0.0, 0.0)) -> None:
         self.engine, self.shape, self.module, self.rule = engine, shape, module, rule
         self.compiler = engine.compilers[id(module)]
         self.local = frozenset(rule.params)
@@ -327,7 +327,8 @@ class Application:
         rule = module.rules[member]
         ctx = self.ctx
         self.children.append((child, module, rule, args,
-                              (ctx.split_index, ctx.split_total, ctx.comp_index, ctx.comp_total)))
+                              (ctx.split_index, ctx.split_total, ctx.comp_index, ctx.comp_total,
+                               ctx.comp_left, ctx.comp_right)))
 
     def target(self, step: n.Successor):
         """The (module, rule name) a parameter used as a successor holds."""
@@ -362,10 +363,11 @@ class Application:
     def piece(self, shape: Shape, body: n.Sequence, split=None, comp=None) -> None:
         """Run a block entry's steps on one piece (a split piece, a face, an inset)."""
         ctx = self.ctx
-        saved = (ctx.split_index, ctx.split_total, ctx.comp_index, ctx.comp_total)
+        saved = (ctx.split_index, ctx.split_total, ctx.comp_index, ctx.comp_total, ctx.comp_left, ctx.comp_right)
         if split is not None:
             ctx.split_index, ctx.split_total = split
         if comp is not None:
-            ctx.comp_index, ctx.comp_total = comp
+            ctx.comp_index, ctx.comp_total, ctx.comp_left, ctx.comp_right = comp
         self.sequence(shape, body.steps)
-        ctx.split_index, ctx.split_total, ctx.comp_index, ctx.comp_total = saved
+        (ctx.split_index, ctx.split_total, ctx.comp_index, ctx.comp_total,
+         ctx.comp_left, ctx.comp_right) = saved

@@ -34,12 +34,12 @@ class Context:
     """What an expression can see while a shape is being derived."""
 
     __slots__ = ("shape", "args", "stream", "seed", "split_index", "split_total",
-                 "comp_index", "comp_total")
+                 "comp_index", "comp_total", "comp_left", "comp_right")
 
-    def __init__(self, shape, args: dict, stream, seed: int, split=(0, 1), comp=(0, 1)) -> None:
+    def __init__(self, shape, args: dict, stream, seed: int, split=(0, 1), comp=(0, 1, 0.0, 0.0)) -> None:
         self.shape, self.args, self.stream, self.seed = shape, args, stream, seed
         self.split_index, self.split_total = split
-        self.comp_index, self.comp_total = comp
+        self.comp_index, self.comp_total, self.comp_left, self.comp_right = comp
 
 
 class RuleRef:
@@ -126,6 +126,10 @@ class Compiler:
             return lambda ctx: ctx.comp_index
         if name == "comp.total":
             return lambda ctx: ctx.comp_total
+        if name == "comp.left":
+            return lambda ctx: ctx.comp_left
+        if name == "comp.right":
+            return lambda ctx: ctx.comp_right
         if name == "depth":
             return lambda ctx: ctx.shape.depth
         if name == "seed":

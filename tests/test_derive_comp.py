@@ -78,3 +78,16 @@ def test_faces_of_an_l_shaped_footprint(tmp_path):
         probe = centre - t.axes[i][2] * 0.01  # just inside the wall
         x, z = probe[0], -probe[2]  # back to GeoJSON's (east, north)
         assert (0 < x < 20 and 0 < z < 10) or (0 < x < 10 and 0 < z < 20)
+
+
+def test_comp_left_and_right_name_the_corners_of_each_side_face():
+    """comp.left/comp.right: 90 at an outer corner, -90 at an inner one, seen from outside."""
+    src = ("Lot --> footprint(L, 0.4, 0.5) extrude(5) comp(f) { side: F(comp.left, comp.right) | all: NIL }\n"
+           "F(l, r) --> label(l == 90 ? (r == 90 ? \"oo\" : \"oi\") : (r == 90 ? \"io\" : \"ii\")) X\n"
+           "terminal X\n")
+    t = bgr.derive(bgr.load(src), lot=(20, 20)).terminals
+    # front, right end of the bar, back of the bar (inner corner on its left), the wing's side
+    # (inner corner on its right), the wing's back, the long left side
+    assert t.label == ["oo", "oo", "io", "oi", "oo", "oo"]
+    box = bgr.derive(bgr.load(src.replace("footprint(L, 0.4, 0.5) ", ""))).terminals
+    assert box.label == ["oo"] * 4

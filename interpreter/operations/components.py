@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from bgr.grammar import nodes as n
@@ -37,27 +39,57 @@ def _faces(app, step, shape):
     up = [0.0, 0.0, 0.0]
     up[k] = 1.0
     if isinstance(geom, Flat):
-        return [([[point(u, v, 0) for u, v in ext], *[[point(u, v, 0) for u, v in h] for h in holes]], up)
-                for ext, holes in polys]
+        return [([[point(u, v, 0) for u, v in ext], *[[point(u, v, 0) for u, v in h] for h in holes]], up,
+                 (0.0, 0.0)) for ext, holes in polys]
     faces = []
     for ext, holes in polys:
         for ring, is_hole in [(ext, False)] + [(h, True) for h in holes]:
-            ccw = signed_area([(u * size[p], v * size[q]) for u, v in ring]) > 0
+            metric = [(u * size[p], v * size[q]) for u, v in ring]
+            ccw = signed_area(metric) > 0
             # (p, q, k) is a left-handed order for k = y (x, z, y): there the sides swap
             outward_right = (ccw != is_hole) != (k == 1)
-            for (u0, v0), (u1, v1) in zip(ring, ring[1:] + ring[:1]):
+            turns = _turns(metric, outer_sign=(1 if ccw else -1) * (-1 if is_hole else 1))
+            n = len(ring)
+            for i, ((u0, v0), (u1, v1)) in enumerate(zip(ring, ring[1:] + ring[:1])):
                 a, b = point(u0, v0, 0), point(u1, v1, 0)
                 edge = [b[i] - a[i] for i in range(3)]
                 nrm = normalise(cross(edge, up) if outward_right else cross(up, edge))
                 if dot(edge, edge) < 1e-18:
                     continue
-                faces.append(([[a, b, point(u1, v1, 1), point(u0, v0, 1)]], nrm))
+                faces.append(([[a, b, point(u1, v1, 1), point(u0, v0, 1)]], nrm, (turns[i], turns[(i + 1) % n])))
     down = [-c for c in up]
     for ext, holes in polys:
-        faces.append(([[point(u, v, 1) for u, v in ext], *[[point(u, v, 1) for u, v in h] for h in holes]], up))
+        faces.append(([[point(u, v, 1) for u, v in ext], *[[point(u, v, 1) for u, v in h] for h in holes]], up,
+                      (0.0, 0.0)))
     for ext, holes in polys:
-        faces.append(([[point(u, v, 0) for u, v in ext], *[[point(u, v, 0) for u, v in h] for h in holes]], down))
+        faces.append(([[point(u, v, 0) for u, v in ext], *[[point(u, v, 0) for u, v in h] for h in holes]], down,
+                      (0.0, 0.0)))
     return faces
+
+
+def _turns(ring, outer_sign: int) -> list[float]:
+    """The angle in degrees the wall turns at each corner of a ring: positive at an outer
+    (convex) corner of the building, negative at an inner one, 0 where it runs straight on."""
+    out = []
+    n = len(ring)
+    for i in range(n):
+        (ax, ay), (bx, by), (cx, cy) = ring[i - 1], ring[i], ring[(i + 1) % n]
+        d1, d2 = (bx - ax, by - ay), (cx - bx, cy - by)
+        angle = math.degrees(math.atan2(d1[0] * d2[1] - d1[1] * d2[0], d1[0] * d2[0] + d1[1] * d2[1]))
+        out.append(0.0 if abs(angle) < 1e-9 else outer_sign * angle)
+    return out
+
+
+def _left_right(rings, nrm, turns) -> tuple[float, float]:
+    """(comp.left, comp.right) of a side face: which end of its bottom edge is on the left as
+    seen from outside follows the face's x axis (section 7), not the ring's direction."""
+    z = nrm
+    if abs(z[1]) > 0.7071:
+        return 0.0, 0.0
+    y = normalise([-z[1] * z[0], 1.0 - z[1] * z[1], -z[1] * z[2]])
+    x = cross(y, z)
+    a, b = rings[0][0], rings[0][1]
+    return turns if dot(a, x) <= dot(b, x) else (turns[1], turns[0])
 
 
 def _classify(nrm) -> str:
@@ -107,17 +139,17 @@ def _matches(app, key, kind: str, index: int) -> bool:
 
 def comp(app, shape, step, args) -> bool:
     faces = _faces(app, step, shape)
-    kinds = [_classify(nrm) for _, nrm in faces]
+    kinds = [_classify(nrm) for _, nrm, _ in faces]
     taken = [False] * len(faces)
     for entry in step.block.entries:
         chosen = [i for i in range(len(faces)) if not taken[i] and _matches(app, entry.key, kinds[i], i)]
         for i in chosen:
             taken[i] = True
         for j, i in enumerate(chosen):
-            rings, nrm = faces[i]
+            rings, nrm, turns = faces[i]
             face = _face_shape(shape, rings, nrm)
             app.engine.count_shape(app.module, entry.pos)
-            app.piece(face, entry.body, comp=(j, len(chosen)))
+            app.piece(face, entry.body, comp=(j, len(chosen), *_left_right(rings, nrm, turns)))
     return True
 
 
