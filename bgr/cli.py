@@ -82,6 +82,23 @@ def build_parser() -> argparse.ArgumentParser:
     render.add_argument("--max-shapes", type=int, default=10_000_000, metavar="N",
                         help="shape budget (10,000,000)")
 
+    infer = commands.add_parser("infer", help="write a grammar from data (face schemas today)",
+                                description="Infer a .bgr grammar from data. --kind schema: "
+                                "Build-by-Number face, floor and model schemas of a labelled, subdivided "
+                                "building: a terminal list (bgr derive -o x.json), a captured-model JSON "
+                                "(docs/inverse-schema.md) or a .bgr (derived first). The grammar, derived "
+                                "with --lot, styles a new mass.")
+    infer.add_argument("input", metavar="INPUT", help="terminal list .json, captured-model .json, or .bgr")
+    infer.add_argument("--kind", choices=["schema", "city", "boxes", "style", "image"], default="schema",
+                       help="what to infer (default schema; the others are not written yet)")
+    infer.add_argument("-o", "--output", metavar="OUT.bgr", help="write here (default: standard output)")
+    infer.add_argument("--fixed", metavar="LABEL,...", default="",
+                       help="labels whose size is fixed (default: window-, door- and entrance-like labels)")
+    infer.add_argument("--stretch", metavar="LABEL,...", default="",
+                       help="labels that stretch (default: every other label)")
+    infer.add_argument("--seed", type=int, default=0, help="seed for deriving a .bgr input (default 0)")
+    infer.add_argument("--lot", metavar="W,D|LOTS.geojson", help="lot for deriving a .bgr input")
+
     fmt = commands.add_parser("fmt", help="print files in the canonical layout",
                               description="Format .bgr files in the canonical layout, keeping "
                               "comments. Without options the result goes to standard output.")
@@ -203,6 +220,28 @@ def cmd_derive(args) -> int:
     return EXIT_OK
 
 
+def cmd_infer(args) -> int:
+    if args.kind != "schema":
+        print(f"bgr infer: --kind {args.kind} is not written yet; --kind schema is", file=sys.stderr)
+        return EXIT_INPUT
+    fixed: dict[str, bool] = {}
+    for option, value in (("--fixed", True), ("--stretch", False)):
+        for label in filter(None, (x.strip() for x in getattr(args, option[2:]).split(","))):
+            if fixed.get(label, value) != value:
+                print(f"bgr infer: label '{label}' is given to both --fixed and --stretch", file=sys.stderr)
+                return EXIT_USAGE
+            fixed[label] = value
+    from .inverse.schema import infer
+
+    text = format_module(infer(args.input, fixed=fixed, seed=args.seed, lot=args.lot))
+    if args.output in (None, "-"):
+        sys.stdout.write(text)
+    else:
+        write_atomic(Path(args.output), text)
+        print(f"{args.output}: {text.count(chr(10))} lines", file=sys.stderr)
+    return EXIT_OK
+
+
 def _parse_size(text: str) -> tuple[int, int] | None:
     width, sep, height = text.lower().partition("x")
     if sep and width.strip().isdigit() and height.strip().isdigit():
@@ -274,7 +313,8 @@ def cmd_render(args) -> int:
     return EXIT_OK
 
 
-COMMANDS = {"check": cmd_check, "fmt": cmd_fmt, "derive": cmd_derive, "render": cmd_render}
+COMMANDS = {"check": cmd_check, "fmt": cmd_fmt, "derive": cmd_derive, "render": cmd_render,
+            "infer": cmd_infer}
 
 
 def main(argv: list[str] | None = None) -> int:

@@ -74,6 +74,20 @@ def examples() -> None:
         print(f"  examples/{name}", file=sys.stderr)
 
 
+def captured() -> None:
+    """examples/captured: the grammar inferred from corner_shop.json re-created at the captured
+    size (before) and applied to a longer, taller mass on an L-shaped lot (after), side by side."""
+    from bgr.inverse.schema import infer
+
+    folder = ROOT / "examples" / "captured"
+    grammar = bgr.load(bgr.format_module(infer(folder / "corner_shop.json")), path=folder / "corner_shop.bgr")
+    before = render(bgr.derive(grammar, lot=(18, 12)), "shaded", "iso", EXAMPLE_SIZE)
+    after = render(bgr.derive(grammar, lot=str(folder / "l_lot.geojson"), attrs={"height": 18.8}),
+                   "shaded", "iso", EXAMPLE_SIZE)
+    save(np.hstack([before, after]), folder / "before_after.png")
+    print("  examples/captured/before_after.png", file=sys.stderr)
+
+
 def thumbnail(module: str, rule: str) -> np.ndarray:
     template, view = WRAPPERS[module]
     if module == "window" and rule.endswith("Entrance"):
@@ -122,6 +136,7 @@ def main(argv: list[str] | None = None) -> int:
     start = time.perf_counter()
     if args.only in (None, "examples"):
         examples()
+        captured()
     if args.only in (None, "stdlib"):
         made = thumbnails()
         contact_sheet(made)

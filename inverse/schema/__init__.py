@@ -1,0 +1,80 @@
+"""Build-by-Number's design schemas (face, floor, model), inferred from a subdivided, labelled
+building and written as a .bgr grammar:
+
+    from bgr.inverse.schema import infer
+    module = infer("terminals.json")          # or a captured-model JSON, or a .bgr to derive
+    text = bgr.format_module(module)
+
+The pipeline: a reader (:mod:`.terminals` for ``bgr derive -o x.json`` output, :mod:`.captured`
+for captured-model JSON) builds a :class:`.model.Model` of subdivided faces; :mod:`.faces` is the
+paper's rewrite algorithm on symbol strings; :mod:`.emit` turns the model into rules.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+from pathlib import Path
+
+from bgr.grammar import nodes as n
+from bgr.grammar.errors import BgrError, Diagnostic
+
+from .model import Model
+
+__all__ = ["Model", "infer", "read_model"]
+
+
+def read_model(source, *, fixed: dict[str, bool] | None = None, seed: int = 0, lot=None) -> Model:
+    """The Model of ``source``: a terminal-list or captured-model JSON path (or its parsed
+    dict), a .bgr path (derived with ``seed`` and ``lot`` first), or a ``bgr.Result``."""
+    from .terminals import model_from_terminals
+
+    if hasattr(source, "terminals") and hasattr(source, "attrs"):  # a bgr.Result
+        import io
+
+        from bgr.interpreter.writers import write_json
+
+        buffer = io.StringIO()
+        write_json(source.terminals, buffer, seed=0, attrs={})
+        return model_from_terminals(json.loads(buffer.getvalue()), "<derived>", fixed)
+    if isinstance(source, dict):
+        return _from_dict(source, "<data>", fixed)
+    path = Path(os.fspath(source))
+    shown = str(source)
+    if path.suffix.lower() == ".bgr":
+        from bgr.interpreter.derive import derive
+
+        model = read_model(derive(path, seed=seed, lot=lot), fixed=fixed)
+        model.source = shown
+        return model
+    try:
+        text = path.read_text(encoding="utf-8")
+    except FileNotFoundError:
+        raise BgrError(Diagnostic(shown, 0, 0, "no such file", "give a terminal list (bgr derive -o x.json), "
+                                  "a captured-model .json or a .bgr")) from None
+    except (OSError, UnicodeDecodeError) as exc:
+        raise BgrError(Diagnostic(shown, 0, 0, f"cannot read the file: {exc}")) from None
+    from .captured import parse  # strict JSON: line and column, duplicate keys, no NaN
+
+    return _from_dict(parse(text, shown), shown, fixed)
+
+
+def _from_dict(data, shown: str, fixed) -> Model:
+    from .terminals import model_from_terminals
+
+    if isinstance(data, dict) and "terminals" in data:
+        return model_from_terminals(data, shown, fixed)
+    if isinstance(data, dict) and ("bgr_captured" in data or "blocks" in data):
+        from .captured import model_from_captured
+
+        return model_from_captured(data, shown, fixed)
+    raise BgrError(Diagnostic(shown, 0, 0, "neither a terminal list nor a captured model",
+                              "a terminal list has a 'terminals' list (bgr derive -o x.json); a captured "
+                              "model has 'bgr_captured' and 'blocks' (docs/inverse-schema.md)"))
+
+
+def infer(source, *, fixed: dict[str, bool] | None = None, seed: int = 0, lot=None) -> n.Module:
+    """The style grammar of ``source`` (see :func:`read_model`) as a syntax tree."""
+    from .emit import Emitter
+
+    return Emitter(read_model(source, fixed=fixed, seed=seed, lot=lot)).module()

@@ -1,0 +1,396 @@
+"""Read a terminal list (``bgr derive -o x.json``) into a :class:`Model` of subdivided faces.
+
+A terminal list has no faces or floors, only labelled rectangles with derivation paths.  The
+structure comes back from both:
+
+* **paths** give the rule tree: every terminal under ``Lot/Mass.0/Front.1/`` was made by the
+  rule application ``Front.1``, and the children of one application, in derivation order, are
+  the pieces of its split;
+* **geometry** says which subtree is one face (all its terminals flat, in one plane, with the
+  same axes) and along which axis a rule's pieces lie (they tile its rectangle along x or y).
+
+Where one rule body nests splits (no path element between them), the pieces are cut apart
+geometrically (guillotine cuts).  Corners come from where faces meet: a face's right bottom
+corner is its neighbour's left one.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import re
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from bgr.grammar.errors import BgrError, Diagnostic
+
+from .model import Block, Cell, Face, Model, default_fixed
+
+TOL = 1e-6  # metres: coordinates that agree this closely are the same
+_HEX = re.compile(r"#[0-9a-fA-F]{6}")
+
+
+@dataclass
+class _Terminal:
+    index: int
+    label: str
+    path: str
+    origin: tuple[float, float, float]
+    axes: tuple[tuple[float, float, float], ...]
+    size: tuple[float, float, float]
+    color: str | None = None
+
+
+@dataclass
+class _Node:
+    path: str
+    items: list = field(default_factory=list)  # child _Node or _Terminal, in derivation order
+    terminals: list = field(default_factory=list)  # every terminal below, in order
+
+    @property
+    def name(self) -> str:
+        last = self.path.rsplit("/", 1)[-1]
+        return last.rsplit(".", 1)[0]
+
+
+def _error(path: str, message: str, hint: str | None = None) -> BgrError:
+    return BgrError(Diagnostic(path, 0, 0, message, hint))
+
+
+def _vector(value, n: int, where: str, path: str) -> tuple:
+    if not isinstance(value, list) or len(value) != n or not all(
+            isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v) for v in value):
+        raise _error(path, f"{where} must be a list of {n} finite numbers, got {json.dumps(value)[:60]}")
+    return tuple(float(v) for v in value)
+
+
+def read_terminals(data: dict, path: str = "<terminals>") -> list[_Terminal]:
+    """The terminals of a parsed terminal-list JSON, checked: each error names the element."""
+    if not isinstance(data, dict) or not isinstance(data.get("terminals"), list):
+        raise _error(path, "not a bgr terminal list: expected an object with a 'terminals' list",
+                     "write one with: bgr derive FILE.bgr -o terminals.json")
+    out = []
+    for i, t in enumerate(data["terminals"]):
+        where = f"terminals[{i}]"
+        if not isinstance(t, dict):
+            raise _error(path, f"{where} is not an object")
+        for key in ("label", "path"):
+            if not isinstance(t.get(key), str) or not t.get(key):
+                raise _error(path, f"{where}.{key} must be a non-empty string")
+        origin = _vector(t.get("origin"), 3, f"{where}.origin", path)
+        axes_raw = t.get("axes")
+        if not isinstance(axes_raw, list) or len(axes_raw) != 3:
+            raise _error(path, f"{where}.axes must be three 3-vectors")
+        axes = tuple(_vector(a, 3, f"{where}.axes[{j}]", path) for j, a in enumerate(axes_raw))
+        size = _vector(t.get("size"), 3, f"{where}.size", path)
+        if min(size) < 0:
+            raise _error(path, f"{where}.size has a negative entry")
+        color = t.get("color")
+        color = color if isinstance(color, str) and _HEX.fullmatch(color) else None
+        out.append(_Terminal(i, t["label"], t["path"], origin, axes, size, color))
+    return out
+
+
+def _tree(terminals: list[_Terminal]) -> _Node:
+    """The rule tree of the paths; children in derivation (first appearance) order."""
+    nodes: dict[str, _Node] = {}
+    root = _Node("")
+
+    def node(path: str) -> _Node:
+        found = nodes.get(path)
+        if found is None:
+            found = nodes[path] = _Node(path)
+            parent = node(path.rsplit("/", 1)[0]) if "/" in path else root
+            parent.items.append(found)
+        return found
+
+    for t in terminals:
+        node(t.path).items.append(t)
+
+    def fill(n: _Node) -> None:
+        for item in n.items:
+            if isinstance(item, _Node):
+                fill(item)
+                n.terminals += item.terminals
+            else:
+                n.terminals.append(item)
+
+    fill(root)
+    return root
+
+
+# ---- faces ------------------------------------------------------------------------------------
+
+def _dot(a, b) -> float:
+    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+
+
+def _same_axes(a, b) -> bool:
+    return all(abs(a[i][j] - b[i][j]) < 1e-6 for i in range(3) for j in range(3))
+
+
+def _flat(t: _Terminal) -> bool:
+    return t.size[2] < TOL
+
+
+DEPTH = 1.0  # metres: recessed glass and extruded frames within this of the wall belong to its face
+
+
+def _coplanar(terminals: list[_Terminal]) -> bool:
+    """One face: the same axes, and all within DEPTH of one plane (a recess or a frame is
+    projected onto the face; its depth is not part of the schema)."""
+    first = terminals[0]
+    normal = first.axes[2]
+    plane = _dot(first.origin, normal)
+    return all(_same_axes(t.axes, first.axes) and abs(_dot(t.origin, normal) - plane) < DEPTH for t in terminals)
+
+
+def _face_nodes(node: _Node, out: list) -> None:
+    """Collect (node or list of terminals) per face: the highest subtrees that lie in one plane."""
+    if node.terminals and _coplanar(node.terminals) and node.path:
+        out.append(node)
+        return
+    loose: dict[tuple, list[_Terminal]] = {}
+    for item in node.items:
+        if isinstance(item, _Node):
+            _face_nodes(item, out)
+        elif _flat(item):
+            key = tuple(round(v, 5) for v in item.axes[2]) + (round(_dot(item.origin, item.axes[2]), 5),)
+            if key not in loose:
+                loose[key] = []
+                out.append(loose[key])  # keeps derivation order among faces
+            loose[key].append(item)
+
+
+@dataclass
+class _Frame:
+    origin: tuple[float, float, float]
+    x: tuple[float, float, float]
+    y: tuple[float, float, float]
+
+    def rect(self, t: _Terminal) -> tuple[float, float, float, float]:
+        d = (t.origin[0] - self.origin[0], t.origin[1] - self.origin[1], t.origin[2] - self.origin[2])
+        u, v = _dot(d, self.x), _dot(d, self.y)
+        return (u, v, u + t.size[0], v + t.size[1])
+
+
+def _union(rects) -> tuple[float, float, float, float]:
+    return (min(r[0] for r in rects), min(r[1] for r in rects), max(r[2] for r in rects), max(r[3] for r in rects))
+
+
+class _Builder:
+    """Turns one face's rule subtree into a Cell tree."""
+
+    def __init__(self, frame: _Frame, fixed: dict[str, bool]) -> None:
+        self.frame, self.fixed = frame, fixed
+
+    def is_fixed(self, label: str) -> bool:
+        return self.fixed.get(label, default_fixed(label))
+
+    def leaf(self, t: _Terminal, size: float) -> Cell:
+        return Cell(size, t.label, fixed=self.is_fixed(t.label))
+
+    def items_of(self, node: _Node):
+        """(rect, item) of a node's children, in derivation order."""
+        out = []
+        for item in node.items:
+            terms = item.terminals if isinstance(item, _Node) else [item]
+            out.append((_union([self.frame.rect(t) for t in terms]), item))
+        return out
+
+    def cell(self, item, rect, size: float) -> Cell:
+        if not isinstance(item, _Node):
+            return self.leaf(item, size)
+        if len(item.items) == 1 and not isinstance(item.items[0], _Node):
+            return self.leaf(item.items[0], size)
+        if len(item.items) == 1:  # a rule that only hands its shape on
+            inner = self.cell(item.items[0], rect, size)
+            if not inner.is_leaf:
+                inner.label = inner.label or item.name
+            return inner
+        children = self.items_of(item)
+        cell = self.partition(children, rect, size) or self.guillotine(
+            [(self.frame.rect(t), t) for t in item.terminals], rect, size)
+        cell.label = item.name
+        return cell
+
+    def partition(self, children, rect, size: float) -> Cell | None:
+        """The children as one split: they lie side by side along x (or y) in derivation order
+        and each spans the whole rectangle across.  Gaps become empty cells."""
+        for axis, lo, hi, a0, a1 in (("x", 0, 2, 1, 3), ("y", 1, 3, 0, 2)):
+            pos = rect[lo]
+            parts = []
+            ok = True
+            for r, item in children:
+                if abs(r[a0] - rect[a0]) > TOL or abs(r[a1] - rect[a1]) > TOL or r[lo] < pos - TOL:
+                    ok = False
+                    break
+                if r[lo] > pos + TOL:
+                    parts.append(Cell(r[lo] - pos))  # a gap the source left empty
+                parts.append(self.cell(item, r, r[hi] - r[lo]))
+                pos = r[hi]
+            if ok and len(parts) > 1:
+                if rect[hi] > pos + TOL:
+                    parts.append(Cell(rect[hi] - pos))
+                return _split(axis, parts, size)
+        return None
+
+    def guillotine(self, items, rect, size: float) -> Cell:
+        """Cut a set of terminal rectangles apart by full cuts (y first, then x): the pieces of
+        splits nested inside one rule body, which no path element separates."""
+        if len(items) == 1:
+            return self.leaf(items[0][1], size)
+        for axis, lo, hi in (("y", 1, 3), ("x", 0, 2)):
+            ordered = sorted(items, key=lambda it: (it[0][lo], it[1].index))
+            groups, end = [], None
+            for r, t in ordered:
+                if end is None or r[lo] >= end - TOL:
+                    groups.append([])
+                    end = r[hi]
+                groups[-1].append((r, t))
+                end = max(end, r[hi])
+            if len(groups) > 1:
+                parts, pos = [], rect[lo]
+                for g in groups:
+                    gr = _union([r for r, _ in g])
+                    if gr[lo] > pos + TOL:
+                        parts.append(Cell(gr[lo] - pos))
+                    sub = list(rect)
+                    sub[lo], sub[hi] = gr[lo], gr[hi]
+                    parts.append(self.guillotine(g, tuple(sub), gr[hi] - gr[lo]))
+                    pos = gr[hi]
+                if rect[hi] > pos + TOL:
+                    parts.append(Cell(rect[hi] - pos))
+                return _split(axis, parts, size)
+        # overlapping pieces: keep the first, the rest cannot be a subdivision
+        return self.leaf(items[0][1], size)
+
+
+def _split(axis: str, parts: list[Cell], size: float) -> Cell:
+    """A subdivided cell; fixed along its parent's axis when nothing in it can stretch."""
+    cell = Cell(size, axis=axis, parts=parts)
+    cell.fixed = _fixed_along(cell, axis)
+    return cell
+
+
+def _fixed_along(cell: Cell, axis: str) -> bool:
+    """Can the cell not stretch along ``axis``?  A leaf by its label; a split along the same axis
+    when all its parts are fixed; a split across it when any part is (a window column cannot be
+    made wider)."""
+    if cell.is_leaf:
+        return cell.fixed
+    if cell.axis == axis:
+        return all(_fixed_along(p, axis) for p in cell.parts)
+    return any(_fixed_along(p, axis) for p in cell.parts)
+
+
+def _set_fixed(cell: Cell, axis: str | None) -> None:
+    """Fill in ``fixed`` of every part along its own parent's axis."""
+    if cell.is_leaf:
+        return
+    for p in cell.parts:
+        _set_fixed(p, cell.axis)
+        p.fixed = _fixed_along(p, cell.axis)
+
+
+# ---- corners and blocks ---------------------------------------------------------------------
+
+def _corner(x_left, x_right) -> str:
+    """The corner between a face (x axis x_left) and its right neighbour (x_right), from outside."""
+    turn = x_left[2] * x_right[0] - x_left[0] * x_right[2]  # y of x_left cross x_right
+    along = x_left[0] * x_right[0] + x_left[2] * x_right[2]
+    if abs(turn) < 1e-6 and along > 0:
+        return "flat"
+    return "outer" if turn > 0 else "inner"
+
+
+def link_faces(faces: list[Face]) -> list[list[Face]]:
+    """Set each vertical face's left/right corner from the face whose bottom corner it shares
+    (``origin``, ``width``, ``x_axis`` in world coordinates); faces linked this way form one
+    block, returned as rings in order.  Used by both readers."""
+    def key(p):
+        return (round(p[0], 4), round(p[1], 4), round(p[2], 4))
+
+    starts = {}
+    for f in faces:
+        starts.setdefault(key(f.origin), []).append(f)
+    right_of: dict[int, Face] = {}
+    for f in faces:
+        end = tuple(f.origin[i] + f.width * f.x_axis[i] for i in range(3))
+        for g in starts.get(key(end), []):
+            if g is not f:
+                right_of[id(f)] = g
+                kind = _corner(f.x_axis, g.x_axis)
+                f.right, g.left = kind, kind
+                break
+    # blocks: follow the links
+    seen, blocks = set(), []
+    for f in faces:
+        if id(f) in seen:
+            continue
+        ring, g = [], f
+        while g is not None and id(g) not in seen:
+            seen.add(id(g))
+            ring.append(g)
+            g = right_of.get(id(g))
+        blocks.append(ring)
+    return blocks
+
+
+def model_from_terminals(data: dict, path: str = "<terminals>", fixed: dict[str, bool] | None = None) -> Model:
+    """The Model of a terminal list: its vertical faces, subdivided, in derivation order, with
+    their corners; horizontal faces' labels are kept for the roof."""
+    terminals = read_terminals(data, path)
+    if not terminals:
+        raise _error(path, "the terminal list is empty: nothing to infer from")
+    fixed = dict(fixed or {})
+    found: list = []
+    _face_nodes(_tree(terminals), found)
+    faces, roofs = [], []
+    for group in found:
+        terms = group.terminals if isinstance(group, _Node) else group
+        first = terms[0]
+        if abs(first.axes[2][1]) > 0.7071:  # a horizontal face: a roof or a floor slab
+            roofs.append(first.label)
+            continue
+        probe = _Frame(first.origin, first.axes[0], first.axes[1])
+        rects = [probe.rect(t) for t in terms]
+        u0, v0, u1, v1 = _union(rects)
+        origin = tuple(first.origin[i] + u0 * first.axes[0][i] + v0 * first.axes[1][i] for i in range(3))
+        frame = _Frame(origin, first.axes[0], first.axes[1])
+        builder = _Builder(frame, fixed)
+        rect = (0.0, 0.0, u1 - u0, v1 - v0)
+        if isinstance(group, _Node):
+            root = builder.cell(group, rect, rect[2])
+            name = group.name
+        else:
+            root = builder.guillotine([(frame.rect(t), t) for t in terms], rect, rect[2])
+            name = first.label
+        _set_fixed(root, None)
+        faces.append(Face(rect[2], rect[3], root, name=name, origin=origin,
+                          x_axis=first.axes[0], normal=first.axes[2], order=len(faces)))
+    if not faces:
+        raise _error(path, "no vertical faces in the terminal list",
+                     "face schemas are inferred from façades: flat terminals on the sides of a mass")
+    blocks = []
+    for i, ring in enumerate(link_faces(faces)):
+        xs = [c for f in ring for c in (f.origin[0], f.origin[0] + f.width * f.x_axis[0])]
+        zs = [c for f in ring for c in (f.origin[2], f.origin[2] + f.width * f.x_axis[2])]
+        blocks.append(Block(f"Block{i}", ring, max(xs) - min(xs), max(zs) - min(zs),
+                            max(f.height for f in ring), footprint=[(f.origin[0], f.origin[2]) for f in ring]))
+    colors: dict[str, str] = {}
+    for t in terminals:  # a label's colour: the first one it comes in
+        if t.color is not None:
+            colors.setdefault(t.label, t.color)
+    return Model(blocks, source=path, roof_labels=roofs, label_colors=colors)
+
+
+def load_terminal_list(path: str | Path, fixed: dict[str, bool] | None = None) -> Model:
+    shown = str(path)
+    try:
+        data = json.loads(Path(path).read_text(encoding="utf-8"))
+    except FileNotFoundError:
+        raise _error(shown, "no such file") from None
+    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as exc:
+        raise _error(shown, f"cannot read the terminal list: {exc}") from None
+    return model_from_terminals(data, shown, fixed)
