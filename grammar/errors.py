@@ -8,8 +8,8 @@ the error's own ``path``, ``line`` and ``column`` are those of the first diagnos
 from __future__ import annotations
 
 import difflib
+from collections.abc import Iterable
 from dataclasses import dataclass
-from typing import Iterable
 
 
 @dataclass
@@ -83,9 +83,26 @@ def suggest(name: str, known: Iterable[str]) -> str | None:
 def source_lines(source: str) -> list[str]:
     """Lines as the lexer counts them: only "\n" ends a line (str.splitlines also breaks at
     "\r", "\f", "\u2028" ... which would put messages and comments on the wrong line)."""
-    return [line[:-1] if line.endswith("\r") else line for line in source.split("\n")]
+    return [line.removesuffix("\r") for line in source.split("\n")]
 
 
 def source_line(source: str, line: int) -> str | None:
     lines = source_lines(source)
     return lines[line - 1] if 0 < line <= len(lines) else None
+
+
+def read_json(path, what: str, hint: str | None = None):
+    """The parsed JSON of a file, or a BgrError that says which file and what is wrong with it
+    (``what`` names the file's role: "lot file", "camera file"...)."""
+    import json
+    from pathlib import Path
+
+    shown = str(path)
+    try:
+        return json.loads(Path(path).read_text(encoding="utf-8"))
+    except FileNotFoundError:
+        raise BgrError(Diagnostic(shown, 0, 0, f"no such {what}", hint)) from None
+    except (OSError, UnicodeDecodeError) as exc:
+        raise BgrError(Diagnostic(shown, 0, 0, f"cannot read the {what}: {exc}")) from None
+    except json.JSONDecodeError as exc:
+        raise BgrError(Diagnostic(shown, exc.lineno, exc.colno, f"not valid JSON: {exc.msg}")) from None

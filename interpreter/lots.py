@@ -6,12 +6,11 @@ edge (its front, the street side) and z pointing into the lot (LANGUAGE.md secti
 
 from __future__ import annotations
 
-import json
 import math
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from bgr.grammar.errors import BgrError, Diagnostic
+from bgr.grammar.errors import BgrError, Diagnostic, read_json
 
 from .geometry.polygons import RECT, is_unit_square, normalise, signed_area
 from .shapes import IDENTITY, Flat, Shape
@@ -76,14 +75,7 @@ def read_geojson(path: Path) -> list[Lot]:
     north is -z.
     """
     shown = str(path)
-    try:
-        data = json.loads(path.read_text(encoding="utf-8"))
-    except FileNotFoundError:
-        raise BgrError(Diagnostic(shown, 0, 0, "no such lot file", "give W,D or a GeoJSON file")) from None
-    except (OSError, UnicodeDecodeError) as e:
-        raise BgrError(Diagnostic(shown, 0, 0, f"cannot read the lot file: {e}")) from None
-    except json.JSONDecodeError as e:
-        raise BgrError(Diagnostic(shown, e.lineno, e.colno, f"not valid JSON: {e.msg}")) from None
+    data = read_json(path, "lot file", "give W,D or a GeoJSON file")
     features = data.get("features") if isinstance(data, dict) else None
     if isinstance(data, dict) and data.get("type") == "Feature":
         features = [data]

@@ -32,12 +32,11 @@ import json
 import math
 import os
 from dataclasses import dataclass
-from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-from ..grammar.errors import BgrError, Diagnostic, suggest
+from ..grammar.errors import BgrError, Diagnostic, read_json, suggest
 
 # A half turn about y: bgr's world (front facing -z) into the paper's model frame (front facing +z).
 FRONT = np.diag([-1.0, 1.0, -1.0])
@@ -145,14 +144,7 @@ class Camera:
     def from_json(cls, path: str | os.PathLike, size=None) -> Camera:
         """Read a camera file (format in docs/cli.md); ``size`` overrides the file's."""
         shown = str(path)
-        try:
-            data = json.loads(Path(path).read_text(encoding="utf-8"))
-        except FileNotFoundError:
-            raise BgrError(Diagnostic(shown, 0, 0, "no such camera file", "check the path")) from None
-        except (OSError, UnicodeDecodeError) as exc:
-            raise BgrError(Diagnostic(shown, 0, 0, f"cannot read the camera file: {exc}")) from None
-        except json.JSONDecodeError as exc:
-            raise BgrError(Diagnostic(shown, exc.lineno, exc.colno, f"not valid JSON: {exc.msg}")) from None
+        data = read_json(path, "camera file", "check the path")
         return cls.from_dict(data, shown, size)
 
     @classmethod

@@ -22,7 +22,7 @@ import re
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from bgr.grammar.errors import BgrError, Diagnostic
+from bgr.grammar.errors import BgrError, Diagnostic, read_json
 
 from .model import Block, Cell, Face, Model, default_fixed
 
@@ -386,11 +386,5 @@ def model_from_terminals(data: dict, path: str = "<terminals>", fixed: dict[str,
 
 
 def load_terminal_list(path: str | Path, fixed: dict[str, bool] | None = None) -> Model:
-    shown = str(path)
-    try:
-        data = json.loads(Path(path).read_text(encoding="utf-8"))
-    except FileNotFoundError:
-        raise _error(shown, "no such file") from None
-    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as exc:
-        raise _error(shown, f"cannot read the terminal list: {exc}") from None
-    return model_from_terminals(data, shown, fixed)
+    data = read_json(path, "terminal list", "write one with: bgr derive FILE.bgr -o terminals.json")
+    return model_from_terminals(data, str(path), fixed)
