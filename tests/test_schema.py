@@ -277,3 +277,25 @@ def test_captured_example_grammar_is_current_and_restyles_an_l_lot():
         "rerun: bgr infer examples/captured/corner_shop.json -o examples/captured/corner_shop.bgr"
     result = bgr.derive(bgr.load(committed), lot=str(folder / "l_lot.geojson"), attrs={"height": 18.8})
     assert len(result) > 200
+
+
+def test_floor_schema_prefers_the_face_with_fewest_occluded_subfaces():
+    """Third criterion: two schemas alike in corners, side and width -> the less occluded one."""
+    from bgr.inverse.schema.emit import Emitter
+    from bgr.inverse.schema.model import Block, Cell, Face, Model
+
+    def face(label, occluded, x_axis, origin):
+        leaf = Cell(4.0, label, occluded=occluded)
+        root = Cell(10.0, axis="x", parts=[Cell(3.0, "Wall"), leaf, Cell(3.0, "Wall")])
+        return Face(10.0, 4.0, root, left="outer", right="outer", name=label, origin=origin,
+                    x_axis=x_axis, normal=(-x_axis[2], 0.0, x_axis[0]))
+
+    faces = [face("Hidden", True, (0.0, 0.0, 1.0), (10.0, 0.0, 0.0)),  # normal (-1, 0, 0): left
+             face("Seen", False, (0.0, 0.0, -1.0), (0.0, 0.0, 10.0))]  # normal (1, 0, 0): right
+    for f in faces:
+        f.normal = (0.0, 0.0, 1.0)  # both face the back: same side, same corners, same width
+    model = Model([Block("b", faces, 10, 10, 4)])
+    text = bgr.format_module(Emitter(model).module())
+    grammar = bgr.load(text)
+    labels = bgr.derive(grammar, lot=(10, 10)).terminals.label
+    assert "Seen" in labels and "Hidden" not in labels

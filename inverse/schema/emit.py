@@ -183,7 +183,13 @@ class Emitter:
         key = "|".join(f"{nm}@{round(f.width, 4)}" for f, nm in names)
         if key in self.by_key:
             return self.by_key[key]
-        widths = sorted(names, key=lambda fn: (fn[0].width, fn[0].occluded()))
+        # among schemas of the same width, the one with the fewest occluded subfaces
+        widths = []
+        for face, name in sorted(names, key=lambda fn: (fn[0].width, fn[0].occluded())):
+            if not widths or face.width - widths[-1][0].width > 1e-6:
+                widths.append((face, name))
+        if len(widths) == 1:
+            return widths[0][1]
         cases = []
         for (a, name), (b, _) in itertools.pairwise(widths):
             mid = (a.width + b.width) / 2
