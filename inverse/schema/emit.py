@@ -112,7 +112,7 @@ class Emitter:
         key = cell.key()
         if key in self.by_key:
             return self.by_key[key]
-        rule_name = self.by_key[key] = self.fresh(name or cell.label or f"{cell.axis.upper()}Split")
+        rule_name = self.by_key[key] = self.fresh(name or cell.label or _auto_name(cell))
         body = n.Sequence([self.split(cell, floors=name is not None)])
         self.rules.append(n.Rule(rule_name, [], body))
         return rule_name
@@ -244,6 +244,15 @@ def _default_color(label: str) -> str:
             return color
     h = sum((i + 1) * ord(c) for i, c in enumerate(label))
     return f"#{0x90 + h % 0x40:02x}{0x90 + (h // 7) % 0x40:02x}{0x90 + (h // 49) % 0x40:02x}"
+
+
+def _auto_name(cell: Cell) -> str:
+    """A name from the labels inside an unnamed cell: its most telling leaf (a fixed one, else
+    the first) and its shape: ``WindowColumn`` for a y split, ``WindowRow`` for an x split."""
+    leaves = [leaf for leaf in cell.leaves() if leaf.label]
+    key = next((leaf for leaf in leaves if leaf.fixed), leaves[0] if leaves else None)
+    base = key.label if key is not None else "Empty"
+    return base[:1].upper() + base[1:] + ("Column" if cell.axis == "y" else "Row")
 
 
 def _extend(items, syms):
