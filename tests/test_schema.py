@@ -299,3 +299,16 @@ def test_floor_schema_prefers_the_face_with_fewest_occluded_subfaces():
     grammar = bgr.load(text)
     labels = bgr.derive(grammar, lot=(10, 10)).terminals.label
     assert "Seen" in labels and "Hidden" not in labels
+
+
+@pytest.mark.parametrize("name, blocks", [("house.bgr", 1), ("stdlib_street.bgr", 1), ("tower.bgr", 2)])
+def test_grammars_with_3d_parts_give_one_face_per_wall(name, blocks):
+    """Recessed glass, frames, sills and reveals at right angles belong to the wall they are set
+    in: the shipped examples (3D windows, roofs, setbacks) give closed rings of whole walls."""
+    model = read_model(ROOT / "examples" / name)
+    assert len(model.blocks) == blocks
+    for block in model.blocks:
+        assert len(block.faces) == 4
+        assert all(f.left != "free" and f.right != "free" for f in block.faces)
+    grammar = bgr.load(bgr.format_module(infer(ROOT / "examples" / name)))
+    assert len(bgr.derive(grammar, lot=(30, 16))) > 50

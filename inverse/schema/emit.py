@@ -223,6 +223,9 @@ class Emitter:
         header = [f"# Inferred by bgr infer --kind schema from {self.model.source or 'a model'}:",
                   f"# {faces} faces, {leaves} subfaces; {len(self.rules)} schema rules. Derive it on a lot:",
                   "#   bgr derive THIS.bgr --lot W,D|LOTS.geojson -o out.glb   (--set height=H)"]
+        if self.model.dropped:
+            header.insert(2, f"# ({self.model.dropped} small faces on no mass, such as the sides of "
+                             "bays and dormers, are left out.)")
         return _laid_out(header, [head, [lot], list(choosers.values()), self.rules, self.colored])
 
 

@@ -115,6 +115,7 @@ class Model:
     labels_fixed: dict[str, bool] = field(default_factory=dict)
     roof_labels: list[str] = field(default_factory=list)  # labels found on horizontal faces
     label_colors: dict[str, str] = field(default_factory=dict)  # "#rrggbb" per label, when known
+    dropped: int = 0  # faces on no mass (parts at odd angles) left out of the schemas
 
     def faces(self) -> list[Face]:
         return [f for b in self.blocks for f in b.faces]

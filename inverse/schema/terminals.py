@@ -145,11 +145,43 @@ def _coplanar(terminals: list[_Terminal]) -> bool:
     return all(_same_axes(t.axes, first.axes) and abs(_dot(t.origin, normal) - plane) < DEPTH for t in terminals)
 
 
+LINK = 0.6  # metres: face corners this close are one corner
+MINOR = 0.35  # parts off the main plane (reveals, sill tops) up to this share of its area
+
+
+def _main_plane(terminals: list[_Terminal]) -> set[int] | None:
+    """The terminals of a subtree's main plane, if the rest are minor parts of it.
+
+    A window with 3D parts puts small terminals at right angles to the wall (the sides of its
+    reveal, the top of its sill); they belong to the face they are set in, not to faces of
+    their own.  The subtree is one face when the terminals in its largest plane (same axes,
+    within DEPTH) outweigh all the others by area; the others are left out of the schema."""
+    groups: list[tuple[_Terminal, list[_Terminal]]] = []
+    for t in terminals:
+        for first, members in groups:
+            if _same_axes(t.axes, first.axes) and abs(
+                    _dot(t.origin, first.axes[2]) - _dot(first.origin, first.axes[2])) < DEPTH:
+                members.append(t)
+                break
+        else:
+            groups.append((t, [t]))
+        if len(groups) > 64:  # many orientations: a whole mass, not one face
+            return None
+    areas = [sum(t.size[0] * t.size[1] for t in members) for _, members in groups]
+    best = max(range(len(groups)), key=lambda i: areas[i])
+    if sum(areas) - areas[best] > MINOR * areas[best]:
+        return None
+    return {t.index for t in groups[best][1]}
+
+
 def _face_nodes(node: _Node, out: list) -> None:
-    """Collect (node or list of terminals) per face: the highest subtrees that lie in one plane."""
-    if node.terminals and _coplanar(node.terminals) and node.path:
-        out.append(node)
-        return
+    """Collect (node, kept terminal indices) or a list of terminals per face: the highest
+    subtrees that lie in one plane, up to minor parts at other angles."""
+    if node.terminals and node.path:
+        kept = {t.index for t in node.terminals} if _coplanar(node.terminals) else _main_plane(node.terminals)
+        if kept:
+            out.append((node, kept))
+            return
     loose: dict[tuple, list[_Terminal]] = {}
     for item in node.items:
         if isinstance(item, _Node):
@@ -181,8 +213,19 @@ def _union(rects) -> tuple[float, float, float, float]:
 class _Builder:
     """Turns one face's rule subtree into a Cell tree."""
 
-    def __init__(self, frame: _Frame, fixed: dict[str, bool]) -> None:
-        self.frame, self.fixed = frame, fixed
+    def __init__(self, frame: _Frame, fixed: dict[str, bool], kept: set[int] | None = None) -> None:
+        self.frame, self.fixed, self.kept = frame, fixed, kept
+
+    def children(self, node: _Node) -> list:
+        """A node's items that hold kept terminals, in derivation order."""
+        if self.kept is None:
+            return node.items
+        return [item for item in node.items
+                if (any(t.index in self.kept for t in item.terminals) if isinstance(item, _Node)
+                    else item.index in self.kept)]
+
+    def terms(self, node: _Node) -> list[_Terminal]:
+        return node.terminals if self.kept is None else [t for t in node.terminals if t.index in self.kept]
 
     def is_fixed(self, label: str) -> bool:
         return self.fixed.get(label, default_fixed(label))
@@ -193,24 +236,25 @@ class _Builder:
     def items_of(self, node: _Node):
         """(rect, item) of a node's children, in derivation order."""
         out = []
-        for item in node.items:
-            terms = item.terminals if isinstance(item, _Node) else [item]
+        for item in self.children(node):
+            terms = self.terms(item) if isinstance(item, _Node) else [item]
             out.append((_union([self.frame.rect(t) for t in terms]), item))
         return out
 
     def cell(self, item, rect, size: float) -> Cell:
         if not isinstance(item, _Node):
             return self.leaf(item, size)
-        if len(item.items) == 1 and not isinstance(item.items[0], _Node):
-            return self.leaf(item.items[0], size)
-        if len(item.items) == 1:  # a rule that only hands its shape on
-            inner = self.cell(item.items[0], rect, size)
+        kids = self.children(item)
+        if len(kids) == 1 and not isinstance(kids[0], _Node):
+            return self.leaf(kids[0], size)
+        if len(kids) == 1:  # a rule that only hands its shape on
+            inner = self.cell(kids[0], rect, size)
             if not inner.is_leaf:
                 inner.label = inner.label or item.name
             return inner
         children = self.items_of(item)
         cell = self.partition(children, rect, size) or self.guillotine(
-            [(self.frame.rect(t), t) for t in item.terminals], rect, size)
+            [(self.frame.rect(t), t) for t in self.terms(item)], rect, size)
         cell.label = item.name
         return cell
 
@@ -308,21 +352,35 @@ def link_faces(faces: list[Face]) -> list[list[Face]]:
     """Set each vertical face's left/right corner from the face whose bottom corner it shares
     (``origin``, ``width``, ``x_axis`` in world coordinates); faces linked this way form one
     block, returned as rings in order.  Used by both readers."""
-    def key(p):
-        return (round(p[0], 4), round(p[1], 4), round(p[2], 4))
+    # corners match within LINK: a cornice or a quoin that stands a little past the wall's
+    # edge widens a face's outline by a few centimetres
+    cell = LINK * 2
 
-    starts = {}
+    def bucket(p):
+        return (math.floor(p[0] / cell), math.floor(p[2] / cell))
+
+    starts: dict[tuple, list[Face]] = {}
     for f in faces:
-        starts.setdefault(key(f.origin), []).append(f)
+        starts.setdefault(bucket(f.origin), []).append(f)
     right_of: dict[int, Face] = {}
+    taken: set[int] = set()
     for f in faces:
         end = tuple(f.origin[i] + f.width * f.x_axis[i] for i in range(3))
-        for g in starts.get(key(end), []):
-            if g is not f:
-                right_of[id(f)] = g
-                kind = _corner(f.x_axis, g.x_axis)
-                f.right, g.left = kind, kind
-                break
+        bx, bz = bucket(end)
+        near = [g for dx in (-1, 0, 1) for dz in (-1, 0, 1) for g in starts.get((bx + dx, bz + dz), [])]
+        best, rank = None, (LINK, 0.0)
+        for g in near:
+            d = math.dist((end[0], end[1], end[2]), g.origin)
+            # the nearest start; at a shared corner the wall that runs straight on (a block
+            # attached flush) before one that turns
+            r = (round(d, 6), -_dot(f.x_axis, g.x_axis))
+            if g is not f and id(g) not in taken and d <= LINK and (best is None or r < rank):
+                best, rank = g, r
+        if best is not None:
+            taken.add(id(best))
+            right_of[id(f)] = best
+            kind = _corner(f.x_axis, best.x_axis)
+            f.right, best.left = kind, kind
     # blocks: follow the links
     seen, blocks = set(), []
     for f in faces:
@@ -348,7 +406,12 @@ def model_from_terminals(data: dict, path: str = "<terminals>", fixed: dict[str,
     _face_nodes(_tree(terminals), found)
     faces, roofs = [], []
     for group in found:
-        terms = group.terminals if isinstance(group, _Node) else group
+        kept = None
+        if isinstance(group, tuple):
+            group, kept = group
+            terms = [t for t in group.terminals if t.index in kept]
+        else:
+            terms = group
         first = terms[0]
         if abs(first.axes[2][1]) > 0.7071:  # a horizontal face: a roof or a floor slab
             roofs.append(first.label)
@@ -358,7 +421,7 @@ def model_from_terminals(data: dict, path: str = "<terminals>", fixed: dict[str,
         u0, v0, u1, v1 = _union(rects)
         origin = tuple(first.origin[i] + u0 * first.axes[0][i] + v0 * first.axes[1][i] for i in range(3))
         frame = _Frame(origin, first.axes[0], first.axes[1])
-        builder = _Builder(frame, fixed)
+        builder = _Builder(frame, fixed, kept)
         rect = (0.0, 0.0, u1 - u0, v1 - v0)
         if isinstance(group, _Node):
             root = builder.cell(group, rect, rect[2])
@@ -372,8 +435,13 @@ def model_from_terminals(data: dict, path: str = "<terminals>", fixed: dict[str,
     if not faces:
         raise _error(path, "no vertical faces in the terminal list",
                      "face schemas are inferred from façades: flat terminals on the sides of a mass")
+    rings = link_faces(faces)
+    # a mass is a closed ring of faces; faces on no ring (the sides of a dormer, a balcony's
+    # front...) are parts of something else and are left out, unless there is no ring at all
+    closed = [ring for ring in rings if all(f.left != "free" and f.right != "free" for f in ring)]
+    dropped = sum(len(r) for r in rings) - sum(len(r) for r in closed) if closed else 0
     blocks = []
-    for i, ring in enumerate(link_faces(faces)):
+    for i, ring in enumerate(closed or rings):
         xs = [c for f in ring for c in (f.origin[0], f.origin[0] + f.width * f.x_axis[0])]
         zs = [c for f in ring for c in (f.origin[2], f.origin[2] + f.width * f.x_axis[2])]
         blocks.append(Block(f"Block{i}", ring, max(xs) - min(xs), max(zs) - min(zs),
@@ -382,7 +450,7 @@ def model_from_terminals(data: dict, path: str = "<terminals>", fixed: dict[str,
     for t in terminals:  # a label's colour: the first one it comes in
         if t.color is not None:
             colors.setdefault(t.label, t.color)
-    return Model(blocks, source=path, roof_labels=roofs, label_colors=colors)
+    return Model(blocks, source=path, roof_labels=roofs, label_colors=colors, dropped=dropped)
 
 
 def load_terminal_list(path: str | Path, fixed: dict[str, bool] | None = None) -> Model:
