@@ -68,6 +68,10 @@ def derive(grammar: Grammar | str | os.PathLike, seed: int = 0, attrs: dict | No
         engine.split_cache = shared_cache
         shape = each.shape.copy()
         engine.derive(shape, start, index=i, several=len(lots) > 1)
+        lot_shape = each.shape  # its frame: the inverse modules read a face's side in it
+        name = start or grammar.start
+        table.lots.append({"path": f"{name}.{i}" if len(lots) > 1 else name, "origin": list(lot_shape.origin),
+                           "axes": [list(a) for a in lot_shape.axes], "size": list(lot_shape.size)})
     values = Engine(grammar, seed, attrs, max_depth, max_shapes).attrs if lots else attrs
     return Result(table.freeze(), seed, values)
 

@@ -312,3 +312,72 @@ def test_grammars_with_3d_parts_give_one_face_per_wall(name, blocks):
         assert all(f.left != "free" and f.right != "free" for f in block.faces)
     grammar = bgr.load(bgr.format_module(infer(ROOT / "examples" / name)))
     assert len(bgr.derive(grammar, lot=(30, 16))) > 50
+
+
+# ---- review cases: GeoJSON lots, gaps, touching lots, ties between groups -----------------------
+
+FRONT_DOOR = """\
+terminal Wall, Door, Window
+Lot --> extrude(8) comp(f) { front: F | side: Wall | top: NIL | bottom: NIL }
+F --> split(x) { ~1: Wall | 1.2: split(y) { 2.4: Door | ~1: Wall } | { ~1: Wall | 1.2: Window }* | ~1: Wall }
+"""
+
+
+def _geojson(tmp_path, rings) -> str:
+    geo = {"type": "FeatureCollection", "features": [
+        {"type": "Feature", "properties": {}, "geometry": {"type": "Polygon", "coordinates": [r + [r[0]]]}}
+        for r in rings]}
+    path = tmp_path / "lots.geojson"
+    path.write_text(json.dumps(geo))
+    return str(path)
+
+
+def _same(src_result, grammar, lot) -> None:
+    a, b = terminals(src_result), terminals(bgr.derive(grammar, lot=lot))
+    assert [t["label"] for t in a] == [t["label"] for t in b]
+    np.testing.assert_allclose([t["size"] for t in a], [t["size"] for t in b], atol=1e-6)
+    np.testing.assert_allclose([t["origin"] for t in a], [t["origin"] for t in b], atol=1e-6)
+
+
+@pytest.mark.parametrize("rings", [
+    [[[0, 0], [16, 0], [16, 14], [0, 14]], [[20, 0], [34, 0], [34, 14], [20, 14]],
+     [[38, 2], [52, 0], [54, 14], [38, 14]]],  # three lots, one a trapezoid: fronts face south
+    [[[0, 0], [10, 0], [10, 12], [0, 12]], [[10, 0], [20, 0], [20, 12], [10, 12]]],  # touching lots
+], ids=["geojson", "touching"])
+def test_round_trip_on_geojson_lots_keeps_each_face_on_its_side(rings, tmp_path):
+    """Sides are read in each lot's frame (a GeoJSON lot's front faces +z), and faces of two
+    lots that touch are two buildings."""
+    lot = _geojson(tmp_path, rings)
+    src = bgr.derive(bgr.load(FRONT_DOOR), lot=lot)
+    model = read_model(src)
+    assert len(model.blocks) == len(rings)
+    assert all(len(b.faces) == 4 for b in model.blocks)
+    _same(src, style(src), lot)
+
+
+@pytest.mark.parametrize("front", [
+    "split(x) { { ~1: Wall | 1.2: split(y) { 2.5: Door } | ~1: Wall }* }",  # a door shorter than its column
+    ("split(x) { 1: Pier | 1.5: Window | 1: Pier | 1.5: Window | 1: Pier | 1.5: Window | 1: Pier | 2: Door "
+     "| 1: Pier | 1.5: Window | 1: Pier | 1.5: Window | 1: Pier | ~1: Wall }"),  # bays, a door, bays
+])
+def test_round_trip_of_nested_gaps_and_tied_groups(front):
+    src_text = ("terminal Wall, Window, Door, Pier\n"
+                f"Lot --> s(17, 0, 10) extrude(4) comp(f) {{ front: {front} | side: Wall | top: NIL | bottom: NIL }}\n")
+    src = bgr.derive(bgr.load(src_text))
+    text = bgr.format_module(infer(src))
+    _same(src, bgr.load(text), (17, 10))
+    if "Pier" in front:
+        assert "}*" in text  # the two groups of bays still repeat
+
+
+def test_a_face_with_an_edge_gap_is_kept():
+    """A gap at the edge of a face narrows it (its extent is its terminals'), but the face stays a
+    face of the mass: its schema is not lost."""
+    src = bgr.derive(bgr.load(
+        "terminal Wall, Window\n"
+        "Lot --> s(20, 0, 12) extrude(6) comp(f) { front: F | side: Wall | top: NIL | bottom: NIL }\n"
+        "F --> split(x) { 1: Wall | 1: Wall | 1: Wall | 2: Window | 1: Wall | 1: Wall | 1.5: Wall }\n"))
+    model = read_model(src)
+    assert model.dropped == 0 and len(model.faces()) == 4
+    out = terminals(bgr.derive(style(src), lot=(20, 12)))
+    assert any(t["label"] == "Window" for t in out)

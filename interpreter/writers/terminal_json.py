@@ -88,7 +88,9 @@ def dumps(table: TerminalTable, *, seed: int, attrs: dict) -> str:
 def _document(table: TerminalTable, seed: int, attrs: dict) -> str:
     head = f'{{\n  "bgr": 1,\n  "seed": {_dumps(seed)},\n  "attrs": {_dumps(attrs)},\n  "terminals": ['
     rows = ",\n".join(["    " + _dumps(t) for t in terminal_dicts(table)])
-    return head + ("\n" + rows + "\n  ]\n}\n" if rows else "]\n}\n")
+    lots = ",\n".join(["    " + _dumps(lot) for lot in table.lots])
+    tail = ',\n  "lots": [\n' + lots + "\n  ]\n}\n" if lots else "\n}\n"
+    return head + ("\n" + rows + "\n  ]" if rows else "]") + tail
 
 
 def write_json(table: TerminalTable, stream: TextIO, *, seed: int, attrs: dict) -> None:

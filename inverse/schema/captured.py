@@ -35,7 +35,7 @@ from .terminals import _set_fixed, link_faces
 
 FORMAT_VERSION = 1
 TOL = 1e-6  # metres: sizes that sum to within this of their cell fit it
-GEOM_TOL = 1e-4  # metres: attached faces this close are coplanar (0.1 mm, link_faces' rounding)
+GEOM_TOL = 1e-4  # metres: attached faces this close are coplanar (0.1 mm)
 MAX_LENGTH = 1e6  # metres: bound on every length and coordinate, so TOL stays meaningful
 MAX_NESTING = 100  # JSON levels: deeper documents are refused before anything recurses into them
 PLAIN = "wall"  # the label of a face the file does not subdivide

@@ -34,7 +34,6 @@ SIDES = ("front", "right", "back", "left")
 _IDENT = re.compile(r"[A-Za-z_][A-Za-z0-9_]*")
 _RESERVED = set(OPERATIONS) | set(KEYWORDS) | set(BUILTIN_NAMES) | {"NIL", "true", "false", "and", "or", "not",
                                                                     "case", "else"}
-CORNER_VALUE = {"outer": 1, "inner": -1, "flat": 0, "free": 1}  # a free edge reads as a corner
 
 
 @dataclass(frozen=True)
@@ -46,11 +45,12 @@ class Run:
 
 
 def _side(face: Face) -> str:
-    """The comp selector a face had: by its outward normal (front is -z, as in section 7)."""
-    x, _, z = face.normal
-    if abs(x) >= abs(z):
-        return "right" if x > 0 else "left"
-    return "back" if z > 0 else "front"
+    """The comp selector a face had: the reader's, or by its outward normal (front is -z)."""
+    if face.side in SIDES:
+        return face.side
+    from .terminals import side_of
+
+    return side_of(face.normal)
 
 
 class Emitter:
@@ -126,7 +126,10 @@ class Emitter:
         keys = [f"{p.key()}@{round(p.size, 4)}{'!' if p.fixed else ''}" for p in parts]
         syms = fs.symbols(keys)
         items = _model_rows(syms) if floors and cell.axis == "y" else _extend(fs.rewrite(syms), syms)
-        items = _expressible(items)
+        if any(isinstance(it, Run) for it in items):
+            items = _expressible(items)
+        else:  # the pair rule's own groups: faces.unroll also settles ties between equal groups
+            items = fs.unroll(items, widths=[p.size for p in parts])
         entries = self.entries(items, parts)
         if not _reproduces(entries, parts, sum(p.size for p in parts)):
             entries = [self.entry(p) for p in parts]  # written out: exact, but it will not grow
@@ -160,13 +163,13 @@ class Emitter:
 
     def chooser(self, side: str, by_side) -> n.Rule:
         """``FrontFacade --> case <corners>: ... | else: ...``: the floor schema's choice."""
-        own = by_side[side]
-        pool = own or [fr for s in SIDES for fr in by_side[s]]
+        pool = [fr for s in SIDES for fr in by_side[s]]
         cases = []
         for left in ("outer", "inner", "flat"):
             for right in ("outer", "inner", "flat"):
                 cond = _and(_corner_test("comp.left", left), _corner_test("comp.right", right))
-                best = _ranked(pool, left, right)
+                best = _ranked(pool, left, right)  # the corners first, then the side it faces
+                best = [fn for fn in best if _side(fn[0]) == side] or best
                 cases.append(n.Case(cond, n.Sequence([n.Successor(self.by_width(best))])))
         cases[-1] = n.Case(None, cases[-1].body)
         return n.Rule(self.fresh(side.capitalize() + "Facade"), [], _body(_merge(cases)))

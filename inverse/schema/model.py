@@ -80,6 +80,7 @@ class Face:
     x_axis: tuple[float, float, float] = (1.0, 0.0, 0.0)
     normal: tuple[float, float, float] = (0.0, 0.0, -1.0)
     order: int = 0  # position in the source's derivation order (the order its terminals came out)
+    lot: str = ""  # the lot (building) it belongs to: faces of different lots never link
 
     @property
     def category(self) -> tuple[str, str]:

@@ -46,6 +46,7 @@ class _Node:
     path: str
     items: list = field(default_factory=list)  # child _Node or _Terminal, in derivation order
     terminals: list = field(default_factory=list)  # every terminal below, in order
+    gathered: bool = False  # a face gathered from a rule's children, not a rule of its own
 
     @property
     def name(self) -> str:
@@ -175,23 +176,34 @@ def _main_plane(terminals: list[_Terminal]) -> set[int] | None:
 
 
 def _face_nodes(node: _Node, out: list) -> None:
-    """Collect (node, kept terminal indices) or a list of terminals per face: the highest
-    subtrees that lie in one plane, up to minor parts at other angles."""
+    """Collect (node, kept terminal indices) per face: the highest subtrees that lie in one
+    plane, up to minor parts at other angles.  Where a rule's children are the pieces of a face
+    with no rule of its own (``comp(f) { front: split(x) { ... } }``), the children in one plane
+    are gathered into one face."""
     if node.terminals and node.path:
         kept = {t.index for t in node.terminals} if _coplanar(node.terminals) else _main_plane(node.terminals)
         if kept:
             out.append((node, kept))
             return
-    loose: dict[tuple, list[_Terminal]] = {}
+    planes: dict[tuple, _Node] = {}
     for item in node.items:
-        if isinstance(item, _Node):
+        terms = item.terminals if isinstance(item, _Node) else [item]
+        if isinstance(item, _Node) and not (terms and _coplanar(terms)):
             _face_nodes(item, out)
-        elif _flat(item):
-            key = tuple(round(v, 5) for v in item.axes[2]) + (round(_dot(item.origin, item.axes[2]), 5),)
-            if key not in loose:
-                loose[key] = []
-                out.append(loose[key])  # keeps derivation order among faces
-            loose[key].append(item)
+            continue
+        if not terms or not any(_flat(t) for t in terms):  # a solid (a roof, a box), no face
+            continue
+        first = terms[0]
+        key = tuple(round(v, 5) for v in first.axes[2]) + (round(_dot(first.origin, first.axes[2]), 5),)
+        if key not in planes:
+            planes[key] = _Node(node.path, gathered=True)
+            out.append(planes[key])  # keeps derivation order among faces
+        planes[key].items.append(item)
+        planes[key].terminals += terms
+    for i, entry in enumerate(out):  # a plane of one child rule is that rule's own face
+        if isinstance(entry, _Node):
+            only = entry.items[0] if len(entry.items) == 1 and isinstance(entry.items[0], _Node) else entry
+            out[i] = (only, {t.index for t in entry.terminals})
 
 
 @dataclass
@@ -258,6 +270,26 @@ class _Builder:
         cell.label = item.name
         return cell
 
+    def fitted(self, item, slot, size: float) -> Cell:
+        """A terminal in a slot it does not fill (a door shorter than its column): the leaf with
+        empty parts beside it, so that the gap keeps its size instead of the leaf growing."""
+        (r, t) = item
+        w, h = r[2] - r[0], r[3] - r[1]
+        short_x = w < slot[2] - slot[0] - TOL
+        short_y = h < slot[3] - slot[1] - TOL
+        cell = self.leaf(t, size if not short_x else h if short_y else w)
+        if short_y:
+            parts = ([Cell(r[1] - slot[1])] if r[1] > slot[1] + TOL else []) + [Cell(h, t.label, fixed=cell.fixed)] + (
+                [Cell(slot[3] - r[3])] if slot[3] > r[3] + TOL else [])
+            cell = _split("y", parts, w if short_x else size)
+        if short_x:
+            inner = cell if short_y else Cell(w, t.label, fixed=cell.fixed)
+            inner.size = w
+            parts = ([Cell(r[0] - slot[0])] if r[0] > slot[0] + TOL else []) + [inner] + (
+                [Cell(slot[2] - r[2])] if slot[2] > r[2] + TOL else [])
+            cell = _split("x", parts, size)
+        return cell
+
     def partition(self, children, rect, size: float) -> Cell | None:
         """The children as one split: they lie side by side along x (or y) in derivation order
         and each spans the whole rectangle across.  Gaps become empty cells."""
@@ -283,7 +315,7 @@ class _Builder:
         """Cut a set of terminal rectangles apart by full cuts (y first, then x): the pieces of
         splits nested inside one rule body, which no path element separates."""
         if len(items) == 1:
-            return self.leaf(items[0][1], size)
+            return self.fitted(items[0], rect, size)
         for axis, lo, hi in (("y", 1, 3), ("x", 0, 2)):
             ordered = sorted(items, key=lambda it: (it[0][lo], it[1].index))
             groups, end = [], None
@@ -337,7 +369,37 @@ def _set_fixed(cell: Cell, axis: str | None) -> None:
         p.fixed = _fixed_along(p, cell.axis)
 
 
-# ---- corners and blocks ---------------------------------------------------------------------
+# ---- lots, sides, corners and blocks --------------------------------------------------------
+
+def _lot_frames(data: dict, path: str) -> dict[str, tuple]:
+    """The axes of each lot (``lots`` of the terminal list, written since this reader exists):
+    a face's side is read in its lot's frame, as comp(f) reads it, not in the world's."""
+    frames = {}
+    lots = data.get("lots", [])
+    if not isinstance(lots, list):
+        raise _error(path, "'lots' must be a list")
+    for i, lot in enumerate(lots):
+        if not isinstance(lot, dict) or not isinstance(lot.get("path"), str):
+            raise _error(path, f"lots[{i}] must be an object with a 'path'")
+        axes = lot.get("axes")
+        if not isinstance(axes, list) or len(axes) != 3:
+            raise _error(path, f"lots[{i}].axes must be three 3-vectors")
+        frames[lot["path"]] = tuple(_vector(a, 3, f"lots[{i}].axes[{j}]", path) for j, a in enumerate(axes))
+    return frames
+
+
+def side_of(normal, axes=None) -> str:
+    """The comp selector of a face by its outward normal in its lot's frame (section 7: front is
+    -z, back +z, left -x, right +x); the world's frame when the lot is not known."""
+    if axes is not None:
+        normal = tuple(_dot(normal, a) for a in axes)
+    x, _, z = normal
+    if abs(x) >= abs(z):
+        return "right" if x > 0 else "left"
+    return "back" if z > 0 else "front"
+
+
+
 
 def _corner(x_left, x_right) -> str:
     """The corner between a face (x axis x_left) and its right neighbour (x_right), from outside."""
@@ -399,19 +461,15 @@ def model_from_terminals(data: dict, path: str = "<terminals>", fixed: dict[str,
     """The Model of a terminal list: its vertical faces, subdivided, in derivation order, with
     their corners; horizontal faces' labels are kept for the roof."""
     terminals = read_terminals(data, path)
+    frames = _lot_frames(data, path)
     if not terminals:
         raise _error(path, "the terminal list is empty: nothing to infer from")
     fixed = dict(fixed or {})
     found: list = []
     _face_nodes(_tree(terminals), found)
     faces, roofs = [], []
-    for group in found:
-        kept = None
-        if isinstance(group, tuple):
-            group, kept = group
-            terms = [t for t in group.terminals if t.index in kept]
-        else:
-            terms = group
+    for group, kept in found:
+        terms = [t for t in group.terminals if t.index in kept]
         first = terms[0]
         if abs(first.axes[2][1]) > 0.7071:  # a horizontal face: a roof or a floor slab
             roofs.append(first.label)
@@ -423,23 +481,29 @@ def model_from_terminals(data: dict, path: str = "<terminals>", fixed: dict[str,
         frame = _Frame(origin, first.axes[0], first.axes[1])
         builder = _Builder(frame, fixed, kept)
         rect = (0.0, 0.0, u1 - u0, v1 - v0)
-        if isinstance(group, _Node):
-            root = builder.cell(group, rect, rect[2])
-            name = group.name
-        else:
-            root = builder.guillotine([(frame.rect(t), t) for t in terms], rect, rect[2])
-            name = first.label
+        root = builder.cell(group, rect, rect[2])
         _set_fixed(root, None)
-        faces.append(Face(rect[2], rect[3], root, name=name, origin=origin,
-                          x_axis=first.axes[0], normal=first.axes[2], order=len(faces)))
+        lot = first.path.split("/", 1)[0]
+        side = side_of(first.axes[2], frames.get(lot))
+        name = side.capitalize() + "Face" if group.gathered else group.name
+        faces.append(Face(rect[2], rect[3], root, name=name, origin=origin, x_axis=first.axes[0],
+                          normal=first.axes[2], order=len(faces), lot=lot, side=side))
     if not faces:
         raise _error(path, "no vertical faces in the terminal list",
                      "face schemas are inferred from façades: flat terminals on the sides of a mass")
-    rings = link_faces(faces)
-    # a mass is a closed ring of faces; faces on no ring (the sides of a dormer, a balcony's
-    # front...) are parts of something else and are left out, unless there is no ring at all
-    closed = [ring for ring in rings if all(f.left != "free" and f.right != "free" for f in ring)]
-    dropped = sum(len(r) for r in rings) - sum(len(r) for r in closed) if closed else 0
+    by_lot: dict[str, list[Face]] = {}
+    for f in faces:
+        by_lot.setdefault(f.lot, []).append(f)
+    rings = [ring for lot_faces in by_lot.values() for ring in link_faces(lot_faces)]
+    # a mass is a closed ring of faces, or faces as large as one; small faces on no ring (the
+    # sides of a dormer, a balcony's front...) are parts of something else and are left out
+    def area(ring):
+        return sum(f.width * f.height for f in ring)
+
+    largest = max(area(r) for r in rings)
+    closed = [ring for ring in rings
+              if all(f.left != "free" and f.right != "free" for f in ring) or area(ring) >= 0.25 * largest]
+    dropped = sum(len(r) for r in rings) - sum(len(r) for r in closed)
     blocks = []
     for i, ring in enumerate(closed or rings):
         xs = [c for f in ring for c in (f.origin[0], f.origin[0] + f.width * f.x_axis[0])]
