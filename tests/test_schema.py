@@ -381,3 +381,15 @@ def test_a_face_with_an_edge_gap_is_kept():
     assert model.dropped == 0 and len(model.faces()) == 4
     out = terminals(bgr.derive(style(src), lot=(20, 12)))
     assert any(t["label"] == "Window" for t in out)
+
+
+def test_terminal_list_lists_each_lot_with_its_frame(tmp_path):
+    """`lots` in the terminal list: the path each lot's terminals start with, and its axes."""
+    rings = [[[0, 0], [10, 0], [10, 12], [0, 12]], [[10, 0], [20, 0], [20, 12], [10, 12]]]
+    buffer = io.StringIO()
+    write_json(bgr.derive(bgr.load(FRONT_DOOR), lot=_geojson(tmp_path, rings)).terminals, buffer, seed=0, attrs={})
+    data = json.loads(buffer.getvalue())
+    lots = data["lots"]
+    assert [lot["path"] for lot in lots] == ["Lot.0", "Lot.1"]
+    assert {t["path"].split("/")[0] for t in data["terminals"]} == {"Lot.0", "Lot.1"}
+    np.testing.assert_allclose(lots[0]["axes"][2], [0, 0, -1], atol=1e-12)  # into the lot: north is -z
