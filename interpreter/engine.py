@@ -276,28 +276,33 @@ class Application:
 
     def arguments(self, step: n.Operation, received: Shape) -> list:
         """Evaluated arguments by the registry's signature: bare words stay words, a relative
-        size becomes ("rel", f), missing optional ones take their defaults; last, ``received``."""
-        signatures = self.engine.signatures
-        sig = signatures.get(id(step))
-        if sig is None:
-            spec, count = OPERATIONS[step.name], len(step.args)
-            sig = signatures[id(step)] = next(
-                s for s, (least, most) in zip(spec.signatures, spec.arities()) if least <= count <= most)
-        count = len(step.args)
-        out = []
+        size becomes ("rel", f), missing optional ones take their defaults; last, ``received``.
+        The plan (what each position is) is worked out once per operation node."""
+        plan = self.engine.signatures.get(id(step))
+        if plan is None:
+            plan = self.engine.signatures[id(step)] = self.plan(step)
+        ctx = self.ctx
+        out = [value if kind == 0 else fn(ctx) if kind == 1 else ("rel", fn(ctx)) for kind, value, fn in plan]
+        out.append(received)
+        return out
+
+    def plan(self, step: n.Operation) -> tuple:
+        """(kind, constant, compiled) per parameter: 0 a word or a default, 1 a value, 2 relative."""
+        spec, count = OPERATIONS[step.name], len(step.args)
+        sig = next(s for s, (least, most) in zip(spec.signatures, spec.arities()) if least <= count <= most)
+        plan = []
         for i, param in enumerate(sig):
             if i >= count:
-                out.append(param.default)
+                plan.append((0, param.default, None))
                 continue
             arg = step.args[i]
             if param.kind in SYMBOL_KINDS:
-                out.append(arg.name)
+                plan.append((0, arg.name, None))
             elif isinstance(arg, n.Relative):
-                out.append(("rel", self.value(arg.expr)))
+                plan.append((2, None, self.engine.compiled(self.compiler, arg.expr, self.local)))
             else:
-                out.append(self.value(arg))
-        out.append(received)
-        return out
+                plan.append((1, None, self.engine.compiled(self.compiler, arg, self.local)))
+        return tuple(plan)
 
     def successor(self, shape: Shape, step: n.Successor, handover: bool = False) -> None:
         if step.name in self.local:  # a rule handed over in a parameter

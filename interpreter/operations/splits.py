@@ -17,17 +17,25 @@ from ..geometry.polygons import RECT, clip, renormalise
 from ..shapes import Prism, Solid
 from ..split_solver import Piece, Repeat, solve
 
-def _items(app, entries) -> tuple:
+def _sizes(app, entries) -> tuple:
+    """The evaluated sizes of a block's entries (a nested tuple for repeat groups): with the
+    block and the length, all the placement depends on, so it keys the solver's memo."""
     out = []
     for entry in entries:
         if isinstance(entry, n.Group):
-            out.append(Repeat(_items(app, entry.entries)))
+            out.append(_sizes(app, entry.entries))
             continue
         size = app.value(entry.key)
         if isinstance(size, bool) or not isinstance(size, (int, float)) or not math.isfinite(size):
             raise runtime_error(app.module, entry.pos, f"a split size must be a finite number, got {size!r}")
-        out.append(Piece(entry.kind, float(size), entry))
+        out.append(float(size))
     return tuple(out)
+
+
+def _items(entries, sizes: tuple) -> tuple:
+    """The solver's items for those sizes (built only when the memo misses)."""
+    return tuple(Repeat(_items(entry.entries, size)) if isinstance(entry, n.Group)
+                 else Piece(entry.kind, size, entry) for entry, size in zip(entries, sizes))
 
 
 def _clip(app, step, geom, axis: int, lo: float, hi: float):
@@ -51,13 +59,14 @@ def _clip(app, step, geom, axis: int, lo: float, hi: float):
 def split(app, shape, step, args) -> bool:
     axis = "xyz".index(args[0])
     length = shape.size[axis]
-    items = _items(app, step.block.entries)
-    if step.block.repeat:
-        items = (Repeat(items),)
-    key = (id(step.block), items, length)
+    sizes = _sizes(app, step.block.entries)
+    key = (id(step.block), sizes, length)
     cache = app.engine.split_cache
     placed = cache.get(key)
     if placed is None:
+        items = _items(step.block.entries, sizes)
+        if step.block.repeat:
+            items = (Repeat(items),)
         placed = solve(items, length)
         if len(cache) > 100_000:
             cache.clear()
