@@ -20,8 +20,14 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent.parent
 DEFAULT_GRAMMAR = ROOT.parent / "shared" / "bench" / "grid_city.bgr"
-PEER = {"n": 20, "derive_s": 5.4, "with_export_s": 9.0, "peak_mb": 1100, "terminals": 246_600,
-        "triangles": 987_000}
+PEER = {
+    "n": 20,
+    "derive_s": 5.4,
+    "with_export_s": 9.0,
+    "peak_mb": 1100,
+    "terminals": 246_600,
+    "triangles": 987_000,
+}
 
 CHILD = r"""
 import json, resource, sys, time
@@ -42,8 +48,11 @@ print(json.dumps({"load_s": t1 - t0, "derive_s": t2 - t1, "write_s": t3 - t2,
 def run(grammar: Path, n: int) -> dict:
     with tempfile.TemporaryDirectory() as tmp:
         out = Path(tmp) / f"grid_{n}.glb"
-        proc = subprocess.run([sys.executable, "-c", CHILD, str(grammar), str(n), str(out)],
-                              capture_output=True, text=True)
+        proc = subprocess.run(
+            [sys.executable, "-c", CHILD, str(grammar), str(n), str(out)],
+            capture_output=True,
+            text=True,
+        )
         if proc.returncode != 0:
             sys.exit(f"n = {n} failed:\n{proc.stderr}")
         stats = json.loads(proc.stdout.strip().splitlines()[-1])
@@ -61,21 +70,27 @@ def main() -> None:
     if not args.grammar.is_file():
         sys.exit(f"{args.grammar}: not found (the benchmark grammar lives in ../shared/bench/)")
     print(f"grammar: {args.grammar}  (cores: {os.cpu_count()})")
-    print(f"{'n':>4} {'terminals':>10} {'triangles':>10} {'derive s':>9} {'write s':>8} {'total s':>8} "
-          f"{'term/s':>9} {'tri/s':>10} {'peak MB':>8} {'GLB MB':>7}")
+    print(
+        f"{'n':>4} {'terminals':>10} {'triangles':>10} {'derive s':>9} {'write s':>8} {'total s':>8} "
+        f"{'term/s':>9} {'tri/s':>10} {'peak MB':>8} {'GLB MB':>7}"
+    )
     rows = []
     for n in args.sizes:
         r = run(args.grammar, n)
         rows.append(r)
-        print(f"{n:>4} {r['terminals']:>10,} {r['triangles']:>10,} {r['derive_s']:>9.2f} {r['write_s']:>8.2f} "
-              f"{r['total_s']:>8.2f} {r['terminals'] / r['total_s']:>9,.0f} {r['triangles'] / r['total_s']:>10,.0f} "
-              f"{r['peak_mb']:>8.0f} {r['glb_mb']:>7.1f}")
+        print(
+            f"{n:>4} {r['terminals']:>10,} {r['triangles']:>10,} {r['derive_s']:>9.2f} {r['write_s']:>8.2f} "
+            f"{r['total_s']:>8.2f} {r['terminals'] / r['total_s']:>9,.0f} {r['triangles'] / r['total_s']:>10,.0f} "
+            f"{r['peak_mb']:>8.0f} {r['glb_mb']:>7.1f}"
+        )
     for r in rows:
         if r["n"] == PEER["n"]:
-            print(f"\nvs ShapeML (C++) at n = 20: derivation {PEER['derive_s'] / r['derive_s']:.2f}x its speed; "
-                  f"derive + GLB {r['total_s']:.2f} s vs its derive + OBJ {PEER['with_export_s']} s "
-                  f"({PEER['with_export_s'] / r['total_s']:.2f}x); peak {r['peak_mb']:.0f} MB vs "
-                  f"{PEER['peak_mb']} MB; target: under 3 s and 500 MB")
+            print(
+                f"\nvs ShapeML (C++) at n = 20: derivation {PEER['derive_s'] / r['derive_s']:.2f}x its speed; "
+                f"derive + GLB {r['total_s']:.2f} s vs its derive + OBJ {PEER['with_export_s']} s "
+                f"({PEER['with_export_s'] / r['total_s']:.2f}x); peak {r['peak_mb']:.0f} MB vs "
+                f"{PEER['peak_mb']} MB; target: under 3 s and 500 MB"
+            )
     if len(rows) > 1:
         base = rows[0]
         for r in rows[1:]:

@@ -63,7 +63,9 @@ def main() -> None:
             grammar = bgr.format_module(module)
             times.append(time.perf_counter() - start)
         rules = sum(1 for item in module.items if type(item).__name__ == "Rule")
-        print(f"{count:8,d}  {statistics.median(times):8.3f}  {min(times):6.3f}  {rules:5d}  {grammar.count(chr(10)):5d}")
+        print(
+            f"{count:8,d}  {statistics.median(times):8.3f}  {min(times):6.3f}  {rules:5d}  {grammar.count(chr(10)):5d}"
+        )
 
 
 if __name__ == "__main__":

@@ -22,14 +22,20 @@ from bgr.grammar.parser import parse
 def generate(lines: int = 5000, seed: int = 0) -> str:
     """A valid grammar of at least ``lines`` lines: whole buildings of 11 varied lines each."""
     rng = random.Random(seed)
-    out = ["version 1", "attr height = 18", "const floor_h = 3.2",
-           "func storeys(h) = floor(h / floor_h)", "terminal Glass, Frame", ""]
+    out = [
+        "version 1",
+        "attr height = 18",
+        "const floor_h = 3.2",
+        "func storeys(h) = floor(h / floor_h)",
+        "terminal Glass, Frame",
+        "",
+    ]
     i = 0
     while len(out) < lines:
         out += [
             f"# building {i}",
             f"Lot{i} --> extrude(height * {rng.uniform(0.5, 2):.3f}) comp(f) {{ top: Roof{i} | front: Front{i} | side: Facade{i} }}",
-            f"Roof{i} --> roof(hip, {rng.randint(20, 45)}, 0.4) color(\"#8a4b3c\")",
+            f'Roof{i} --> roof(hip, {rng.randint(20, 45)}, 0.4) color("#8a4b3c")',
             f"Front{i} --> split(y) {{ 4: Shop{i} | {{ ~floor_h: Floor{i}(split.index) }}* | 1: Cornice{i} }}",
             f"Facade{i} --> split(y) {{ ~floor_h: Floor{i}(split.index) }}*",
             f"Floor{i}(k) --> split(x) {{ 1: Wall{i} | {{ ~3: Tile{i}(k) }}* | 1: Wall{i} }}",
@@ -37,7 +43,7 @@ def generate(lines: int = 5000, seed: int = 0) -> str:
             f"Win{i} --> 60%: [ t(0, 0, -0.2) i(cube) Glass ] Frame | 30%: s('1, '0.8, 0) Glass | else: NIL",
             f"Shop{i} --> split(x) {{ 0.5: Wall{i} | {{ ~4: offset(-0.2) {{ inside: Glass | border: Frame }} }}* | 0.5: Wall{i} }}",
             f"Cornice{i} --> extrude(0.3 + rand(0, 0.2)) color(0.8, 0.8, 0.7)",
-            f"Wall{i} --> color(\"#d8d0c0\")",
+            f'Wall{i} --> color("#d8d0c0")',
         ]
         i += 1
     return "\n".join(out) + "\n"
@@ -56,14 +62,23 @@ def main() -> None:
     args = ap.parse_args()
     parse("A --> B\n")  # build the LALR tables once, as a long-running process would
     text = generate(args.lines)
-    n_lines, n_tokens = len(text.splitlines()), sum(1 for _ in __import__("re").finditer(r"\S+", text))
+    n_lines, n_tokens = (
+        len(text.splitlines()),
+        sum(1 for _ in __import__("re").finditer(r"\S+", text)),
+    )
     parse_times = [timed(parse, text) for _ in range(args.repeat)]
     load_times = [timed(bgr.load, text) for _ in range(args.repeat)]
-    print(f"machine: {platform.processor() or platform.machine()}, Python {platform.python_version()}, "
-          f"bgr {bgr.__version__}")
+    print(
+        f"machine: {platform.processor() or platform.machine()}, Python {platform.python_version()}, "
+        f"bgr {bgr.__version__}"
+    )
     print(f"input: {n_lines} lines, {len(text)} characters, ~{n_tokens} words")
-    print(f"parse only:           median {statistics.median(parse_times):.3f} s, best {min(parse_times):.3f} s")
-    print(f"load (parse + check): median {statistics.median(load_times):.3f} s, best {min(load_times):.3f} s")
+    print(
+        f"parse only:           median {statistics.median(parse_times):.3f} s, best {min(parse_times):.3f} s"
+    )
+    print(
+        f"load (parse + check): median {statistics.median(load_times):.3f} s, best {min(load_times):.3f} s"
+    )
     print(f"lines per second (load, median): {n_lines / statistics.median(load_times):,.0f}")
     print("target: under 2 s ->", "met" if statistics.median(load_times) < 2.0 else "NOT met")
 

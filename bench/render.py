@@ -57,38 +57,61 @@ def main() -> None:
     scene = load_scene(result)
     scene_s = time.perf_counter() - t
     size = (args.size, args.size)
-    print(f"model: {args.grammar.name} n = {args.n}: {len(result):,} terminals, {len(scene):,} triangles "
-          f"(derive {derive_s:.2f} s, scene {scene_s:.2f} s); image {size[0]}x{size[1]}; cores: {os.cpu_count()}")
+    print(
+        f"model: {args.grammar.name} n = {args.n}: {len(result):,} terminals, {len(scene):,} triangles "
+        f"(derive {derive_s:.2f} s, scene {scene_s:.2f} s); image {size[0]}x{size[1]}; cores: {os.cpu_count()}"
+    )
 
     t = time.perf_counter()
     gl = raster_gl.available()
     context_s = time.perf_counter() - t
     if gl:
         info = raster_gl._context()["ctx"].info
-        print(f"GL: {info['GL_RENDERER']}, {info['GL_VERSION']}; context made in {context_s:.2f} s (once per process)")
+        print(
+            f"GL: {info['GL_RENDERER']}, {info['GL_VERSION']}; context made in {context_s:.2f} s (once per process)"
+        )
     else:
         print(f"GL: not available ({raster_gl._state.get('error')}); numpy only")
 
     backends = [("gl", raster_gl.rasterise)] if gl else []
     backends.append(("numpy", raster_numpy.rasterise))
-    print(f"\n{'backend':<8} {'view':<6} {'covered':>8} {'raster med s':>13} {'best s':>7} "
-          f"{'render med s':>13} {'best s':>7}")
+    print(
+        f"\n{'backend':<8} {'view':<6} {'covered':>8} {'raster med s':>13} {'best s':>7} "
+        f"{'render med s':>13} {'best s':>7}"
+    )
     for name, rasterise in backends:
         for view in VIEWS:
             cam = Camera.preset(view, *scene.bounds(), size=size)
             frame = rasterise(scene.triangles, cam)  # warm up (and the GL framebuffer)
             raster = timed(lambda r=rasterise, c=cam: r(scene.triangles, c), args.repeats)
-            whole = timed(lambda r=rasterise, c=cam: images.shaded(r(scene.triangles, c), scene), args.repeats)
-            print(f"{name:<8} {view:<6} {frame.mask.mean():>7.1%} {raster[0]:>13.3f} {raster[1]:>7.3f} "
-                  f"{whole[0]:>13.3f} {whole[1]:>7.3f}")
+            whole = timed(
+                lambda r=rasterise, c=cam: images.shaded(r(scene.triangles, c), scene), args.repeats
+            )
+            print(
+                f"{name:<8} {view:<6} {frame.mask.mean():>7.1%} {raster[0]:>13.3f} {raster[1]:>7.3f} "
+                f"{whole[0]:>13.3f} {whole[1]:>7.3f}"
+            )
 
     with tempfile.TemporaryDirectory() as tmp:
         glb = Path(tmp) / "city.glb"
         result.save(glb)
-        print(f"\ncommand line, fresh process each: bgr render city.glb -o x.png --size {size[0]}x{size[1]}")
+        print(
+            f"\ncommand line, fresh process each: bgr render city.glb -o x.png --size {size[0]}x{size[1]}"
+        )
         for name, _ in backends:
-            cmd = [sys.executable, "-m", "bgr", "render", str(glb), "-o", str(Path(tmp) / "x.png"),
-                   "--size", f"{size[0]}x{size[1]}", "--backend", name]
+            cmd = [
+                sys.executable,
+                "-m",
+                "bgr",
+                "render",
+                str(glb),
+                "-o",
+                str(Path(tmp) / "x.png"),
+                "--size",
+                f"{size[0]}x{size[1]}",
+                "--backend",
+                name,
+            ]
             runs = []
             for _ in range(3):
                 t = time.perf_counter()
@@ -96,7 +119,9 @@ def main() -> None:
                 runs.append(time.perf_counter() - t)
                 if proc.returncode != 0:
                     sys.exit(proc.stderr)
-            print(f"  --backend {name:<6} median {statistics.median(runs):.2f} s, best {min(runs):.2f} s")
+            print(
+                f"  --backend {name:<6} median {statistics.median(runs):.2f} s, best {min(runs):.2f} s"
+            )
 
 
 if __name__ == "__main__":

@@ -26,8 +26,22 @@ from bgr.interpreter.writers import write
 from bgr.interpreter.writers.glb import write_glb
 
 BOX_V = np.array([[x, y, z] for x in (0, 1) for y in (0, 1) for z in (0, 1)], dtype=float)
-BOX_F = np.array([[0, 1, 3], [0, 3, 2], [4, 6, 7], [4, 7, 5], [0, 4, 5], [0, 5, 1],
-                  [2, 3, 7], [2, 7, 6], [0, 2, 6], [0, 6, 4], [1, 5, 7], [1, 7, 3]])
+BOX_F = np.array(
+    [
+        [0, 1, 3],
+        [0, 3, 2],
+        [4, 6, 7],
+        [4, 7, 5],
+        [0, 4, 5],
+        [0, 5, 1],
+        [2, 3, 7],
+        [2, 7, 6],
+        [0, 2, 6],
+        [0, 6, 4],
+        [1, 5, 7],
+        [1, 7, 3],
+    ]
+)
 QUAD_F = np.array([[0, 1, 2], [0, 2, 3]])
 
 
@@ -52,7 +66,9 @@ def table(n: int, seed: int = 0) -> TerminalTable:
     t.path = [f"Lot/Box.{i}" for i in range(n)] + [f"Lot/Quad.{i}" for i in range(n)]
     t.origin = np.concatenate([rng.uniform(0, 1000, (n, 3)), rng.uniform(0, 1000, (n, 3))])
     t.axes = np.concatenate([rot, np.broadcast_to(np.eye(3), (n, 3, 3))])
-    t.size = np.concatenate([rng.uniform(1, 20, (n, 3)), np.column_stack([rng.uniform(1, 5, (n, 2)), z])])
+    t.size = np.concatenate(
+        [rng.uniform(1, 20, (n, 3)), np.column_stack([rng.uniform(1, 5, (n, 2)), z])]
+    )
     t.color = np.concatenate([palette[rng.integers(0, 4, n)], palette[rng.integers(0, 4, n)]])
     t.material = [None] * (2 * n)
     t.mesh = [box] * n + quads
@@ -72,15 +88,21 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--triangles", type=int, default=1_000_000)
     ap.add_argument("--repeat", type=int, default=5)
-    ap.add_argument("--out", type=Path, default=None, help="folder for the files (default: a temp dir)")
+    ap.add_argument(
+        "--out", type=Path, default=None, help="folder for the files (default: a temp dir)"
+    )
     args = ap.parse_args()
     n = max(1, args.triangles // 14)
     start = time.perf_counter()
     t = table(n)
-    print(f"table: {len(t):,} terminals, {t.triangle_count():,} triangles "
-          f"(built in {time.perf_counter() - start:.2f} s)")
-    print(f"python {platform.python_version()}, numpy {np.__version__}, {platform.machine()}, "
-          f"{os.cpu_count()} cpus")
+    print(
+        f"table: {len(t):,} terminals, {t.triangle_count():,} triangles "
+        f"(built in {time.perf_counter() - start:.2f} s)"
+    )
+    print(
+        f"python {platform.python_version()}, numpy {np.__version__}, {platform.machine()}, "
+        f"{os.cpu_count()} cpus"
+    )
     with tempfile.TemporaryDirectory(dir=args.out) as tmp:
         for label, instancing in [("instanced (auto)", "auto"), ("no instancing", False)]:
             path = Path(tmp) / f"bench_{instancing}.glb"
@@ -93,8 +115,10 @@ def main() -> None:
                         write_glb(t, f, seed=0, attrs={}, instancing=False)
 
             median, best = timed(run, args.repeat)
-            print(f"glb {label:17s}: median {median:.3f} s, best {best:.3f} s, "
-                  f"{path.stat().st_size / 1e6:.1f} MB")
+            print(
+                f"glb {label:17s}: median {median:.3f} s, best {best:.3f} s, "
+                f"{path.stat().st_size / 1e6:.1f} MB"
+            )
         for ext in ["json", "ply", "stl", "obj"]:
             path = Path(tmp) / f"bench.{ext}"
             median, best = timed(lambda: write(t, path, seed=0, attrs={}), 1)

@@ -22,5 +22,17 @@ try:
 except PackageNotFoundError:  # pragma: no cover - running from a source tree without install
     __version__ = "0+unknown"
 
-__all__ = ["load", "derive", "Result", "parse", "format_source", "format_module", "Grammar", "BgrError",
-           "BgrSyntaxError", "BgrCheckError", "Diagnostic", "__version__"]
+__all__ = [
+    "load",
+    "derive",
+    "Result",
+    "parse",
+    "format_source",
+    "format_module",
+    "Grammar",
+    "BgrError",
+    "BgrSyntaxError",
+    "BgrCheckError",
+    "Diagnostic",
+    "__version__",
+]

@@ -31,81 +31,169 @@ class _Parser(argparse.ArgumentParser):
 
 
 def build_parser() -> argparse.ArgumentParser:
-    parser = _Parser(prog="bgr", description="bgr: a building-grammar toolkit. "
-                     "Write .bgr shape grammars, check and format them, derive them into meshes.",
-                     epilog="Exit status: 0 success, 1 bad input, 2 bad usage. "
-                     "Language reference: docs/language.md.")
+    parser = _Parser(
+        prog="bgr",
+        description="bgr: a building-grammar toolkit. "
+        "Write .bgr shape grammars, check and format them, derive them into meshes.",
+        epilog="Exit status: 0 success, 1 bad input, 2 bad usage. "
+        "Language reference: docs/language.md.",
+    )
     parser.add_argument("--version", action="version", version=f"bgr {__version__}")
     commands = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
 
-    check = commands.add_parser("check", help="parse, resolve names and report every error",
-                                description="Parse each file, resolve its imports and names, and "
-                                "report every error found. Exit 0 when all files are clean.")
-    check.add_argument("files", nargs="+", metavar="FILE", help=".bgr files ('-' reads standard input)")
+    check = commands.add_parser(
+        "check",
+        help="parse, resolve names and report every error",
+        description="Parse each file, resolve its imports and names, and "
+        "report every error found. Exit 0 when all files are clean.",
+    )
+    check.add_argument(
+        "files", nargs="+", metavar="FILE", help=".bgr files ('-' reads standard input)"
+    )
     check.add_argument("-q", "--quiet", action="store_true", help="print nothing for clean files")
 
-    derive = commands.add_parser("derive", help="derive a grammar into a mesh or a terminal list",
-                                 description="Derive FILE.bgr on a lot and write the result; the "
-                                 "format follows the output's extension (.glb .gltf .obj .ply .stl .json).")
+    derive = commands.add_parser(
+        "derive",
+        help="derive a grammar into a mesh or a terminal list",
+        description="Derive FILE.bgr on a lot and write the result; the "
+        "format follows the output's extension (.glb .gltf .obj .ply .stl .json).",
+    )
     derive.add_argument("file", metavar="FILE.bgr")
-    derive.add_argument("-o", "--output", metavar="OUT", help="output file ('-' with --format json: stdout)")
-    derive.add_argument("--format", choices=["glb", "gltf", "obj", "ply", "stl", "json"],
-                        help="output format when the extension does not say it (json for stdout)")
+    derive.add_argument(
+        "-o", "--output", metavar="OUT", help="output file ('-' with --format json: stdout)"
+    )
+    derive.add_argument(
+        "--format",
+        choices=["glb", "gltf", "obj", "ply", "stl", "json"],
+        help="output format when the extension does not say it (json for stdout)",
+    )
     derive.add_argument("--seed", type=int, default=0, help="global random seed (default 0)")
-    derive.add_argument("--set", action="append", default=[], metavar="NAME=VALUE",
-                        help="override an attr; repeatable")
-    derive.add_argument("--lot", metavar="W,D|LOTS.geojson",
-                        help="the lot: width,depth in metres (default 20,20) or GeoJSON footprints")
-    derive.add_argument("--max-depth", type=int, default=256, metavar="N", help="rule depth limit (256)")
-    derive.add_argument("--max-shapes", type=int, default=10_000_000, metavar="N",
-                        help="shape budget (10,000,000)")
+    derive.add_argument(
+        "--set",
+        action="append",
+        default=[],
+        metavar="NAME=VALUE",
+        help="override an attr; repeatable",
+    )
+    derive.add_argument(
+        "--lot",
+        metavar="W,D|LOTS.geojson",
+        help="the lot: width,depth in metres (default 20,20) or GeoJSON footprints",
+    )
+    derive.add_argument(
+        "--max-depth", type=int, default=256, metavar="N", help="rule depth limit (256)"
+    )
+    derive.add_argument(
+        "--max-shapes", type=int, default=10_000_000, metavar="N", help="shape budget (10,000,000)"
+    )
 
-    render = commands.add_parser("render", help="draw a grammar or a model into a PNG preview",
-                                 description="Derive FILE.bgr (or read FILE.glb / FILE.gltf) and draw it "
-                                 "headless into a PNG: shaded, silhouette, lines or labels.")
+    render = commands.add_parser(
+        "render",
+        help="draw a grammar or a model into a PNG preview",
+        description="Derive FILE.bgr (or read FILE.glb / FILE.gltf) and draw it "
+        "headless into a PNG: shaded, silhouette, lines or labels.",
+    )
     render.add_argument("file", metavar="FILE.bgr|FILE.glb")
     render.add_argument("-o", "--output", metavar="OUT.png", help="the PNG to write")
-    render.add_argument("--mode", choices=["shaded", "silhouette", "lines", "labels"], default="shaded",
-                        help="what to draw (default shaded)")
-    render.add_argument("--view", default="iso", metavar="front|iso|top|CAMERA.json",
-                        help="a view fitted to the model (default iso) or a camera file")
-    render.add_argument("--size", metavar="WxH", help="image size in pixels (default 1024x768, or the camera file's)")
-    render.add_argument("--backend", choices=["auto", "gl", "numpy"], default="auto",
-                        help="rasteriser: OpenGL (EGL), numpy, or auto: GL when it can (default)")
-    render.add_argument("--legend", action="store_true",
-                        help="with --mode labels: also write OUT.legend.json (label -> colour)")
-    render.add_argument("--seed", type=int, default=None, help="global random seed for a .bgr (default 0)")
-    render.add_argument("--set", action="append", default=[], metavar="NAME=VALUE",
-                        help="override an attr of a .bgr; repeatable")
-    render.add_argument("--lot", metavar="W,D|LOTS.geojson", help="the lot of a .bgr, as for derive")
-    render.add_argument("--max-depth", type=int, default=256, metavar="N", help="rule depth limit (256)")
-    render.add_argument("--max-shapes", type=int, default=10_000_000, metavar="N",
-                        help="shape budget (10,000,000)")
+    render.add_argument(
+        "--mode",
+        choices=["shaded", "silhouette", "lines", "labels"],
+        default="shaded",
+        help="what to draw (default shaded)",
+    )
+    render.add_argument(
+        "--view",
+        default="iso",
+        metavar="front|iso|top|CAMERA.json",
+        help="a view fitted to the model (default iso) or a camera file",
+    )
+    render.add_argument(
+        "--size",
+        metavar="WxH",
+        help="image size in pixels (default 1024x768, or the camera file's)",
+    )
+    render.add_argument(
+        "--backend",
+        choices=["auto", "gl", "numpy"],
+        default="auto",
+        help="rasteriser: OpenGL (EGL), numpy, or auto: GL when it can (default)",
+    )
+    render.add_argument(
+        "--legend",
+        action="store_true",
+        help="with --mode labels: also write OUT.legend.json (label -> colour)",
+    )
+    render.add_argument(
+        "--seed", type=int, default=None, help="global random seed for a .bgr (default 0)"
+    )
+    render.add_argument(
+        "--set",
+        action="append",
+        default=[],
+        metavar="NAME=VALUE",
+        help="override an attr of a .bgr; repeatable",
+    )
+    render.add_argument(
+        "--lot", metavar="W,D|LOTS.geojson", help="the lot of a .bgr, as for derive"
+    )
+    render.add_argument(
+        "--max-depth", type=int, default=256, metavar="N", help="rule depth limit (256)"
+    )
+    render.add_argument(
+        "--max-shapes", type=int, default=10_000_000, metavar="N", help="shape budget (10,000,000)"
+    )
 
-    infer = commands.add_parser("infer", help="write a grammar from data (face schemas today)",
-                                description="Infer a .bgr grammar from data. --kind schema: "
-                                "Build-by-Number face, floor and model schemas of a labelled, subdivided "
-                                "building: a terminal list (bgr derive -o x.json), a captured-model JSON "
-                                "(docs/inverse-schema.md) or a .bgr (derived first). The grammar, derived "
-                                "with --lot, styles a new mass.")
-    infer.add_argument("input", metavar="INPUT", help="terminal list .json, captured-model .json, or .bgr")
-    infer.add_argument("--kind", choices=["schema", "city", "boxes", "style", "image"], default="schema",
-                       help="what to infer (default schema; the others are not written yet)")
-    infer.add_argument("-o", "--output", metavar="OUT.bgr", help="write here (default: standard output)")
-    infer.add_argument("--fixed", metavar="LABEL,...", default="",
-                       help="labels whose size is fixed (default: window-, door- and entrance-like labels)")
-    infer.add_argument("--stretch", metavar="LABEL,...", default="",
-                       help="labels that stretch (default: every other label)")
-    infer.add_argument("--seed", type=int, default=0, help="seed for deriving a .bgr input (default 0)")
+    infer = commands.add_parser(
+        "infer",
+        help="write a grammar from data (face schemas today)",
+        description="Infer a .bgr grammar from data. --kind schema: "
+        "Build-by-Number face, floor and model schemas of a labelled, subdivided "
+        "building: a terminal list (bgr derive -o x.json), a captured-model JSON "
+        "(docs/inverse-schema.md) or a .bgr (derived first). The grammar, derived "
+        "with --lot, styles a new mass.",
+    )
+    infer.add_argument(
+        "input", metavar="INPUT", help="terminal list .json, captured-model .json, or .bgr"
+    )
+    infer.add_argument(
+        "--kind",
+        choices=["schema", "city", "boxes", "style", "image"],
+        default="schema",
+        help="what to infer (default schema; the others are not written yet)",
+    )
+    infer.add_argument(
+        "-o", "--output", metavar="OUT.bgr", help="write here (default: standard output)"
+    )
+    infer.add_argument(
+        "--fixed",
+        metavar="LABEL,...",
+        default="",
+        help="labels whose size is fixed (default: window-, door- and entrance-like labels)",
+    )
+    infer.add_argument(
+        "--stretch",
+        metavar="LABEL,...",
+        default="",
+        help="labels that stretch (default: every other label)",
+    )
+    infer.add_argument(
+        "--seed", type=int, default=0, help="seed for deriving a .bgr input (default 0)"
+    )
     infer.add_argument("--lot", metavar="W,D|LOTS.geojson", help="lot for deriving a .bgr input")
 
-    fmt = commands.add_parser("fmt", help="print files in the canonical layout",
-                              description="Format .bgr files in the canonical layout, keeping "
-                              "comments. Without options the result goes to standard output.")
-    fmt.add_argument("files", nargs="+", metavar="FILE", help=".bgr files ('-' reads standard input)")
+    fmt = commands.add_parser(
+        "fmt",
+        help="print files in the canonical layout",
+        description="Format .bgr files in the canonical layout, keeping "
+        "comments. Without options the result goes to standard output.",
+    )
+    fmt.add_argument(
+        "files", nargs="+", metavar="FILE", help=".bgr files ('-' reads standard input)"
+    )
     mode = fmt.add_mutually_exclusive_group()
-    mode.add_argument("--check", action="store_true",
-                      help="change nothing; exit 1 if a file is not formatted")
+    mode.add_argument(
+        "--check", action="store_true", help="change nothing; exit 1 if a file is not formatted"
+    )
     mode.add_argument("-w", "--write", action="store_true", help="rewrite the files in place")
     return parser
 
@@ -187,7 +275,9 @@ def _parse_value(text: str):
         value = float(text)
     except ValueError:
         return text[1:-1] if len(text) >= 2 and text[0] == text[-1] == '"' else text
-    return int(value) if value.is_integer() and "." not in text and "e" not in text.lower() else value
+    return (
+        int(value) if value.is_integer() and "." not in text and "e" not in text.lower() else value
+    )
 
 
 def cmd_derive(args) -> int:
@@ -195,8 +285,11 @@ def cmd_derive(args) -> int:
     from .interpreter.writers import write, write_json
 
     if args.output in (None, "-") and args.format != "json":
-        print("bgr derive: give an output file with -o OUT.glb (or -o - --format json for the "
-              "terminal list on standard output)", file=sys.stderr)
+        print(
+            "bgr derive: give an output file with -o OUT.glb (or -o - --format json for the "
+            "terminal list on standard output)",
+            file=sys.stderr,
+        )
         return EXIT_USAGE
     attrs = {}
     for item in args.set:
@@ -209,26 +302,41 @@ def cmd_derive(args) -> int:
         print("bgr derive: --max-depth and --max-shapes must be positive", file=sys.stderr)
         return EXIT_USAGE
     grammar = load(Path(args.file), path=args.file)
-    result = derive(grammar, seed=args.seed, attrs=attrs, lot=args.lot,
-                    max_depth=args.max_depth, max_shapes=args.max_shapes)
+    result = derive(
+        grammar,
+        seed=args.seed,
+        attrs=attrs,
+        lot=args.lot,
+        max_depth=args.max_depth,
+        max_shapes=args.max_shapes,
+    )
     if args.output in (None, "-"):
         write_json(result.terminals, sys.stdout, seed=args.seed, attrs=result.attrs)
     else:
-        write(result.terminals, Path(args.output), seed=args.seed, attrs=result.attrs, fmt=args.format)
-        print(f"{args.output}: {len(result):,} terminals, {result.terminals.triangle_count():,} triangles",
-              file=sys.stderr)
+        write(
+            result.terminals, Path(args.output), seed=args.seed, attrs=result.attrs, fmt=args.format
+        )
+        print(
+            f"{args.output}: {len(result):,} terminals, {result.terminals.triangle_count():,} triangles",
+            file=sys.stderr,
+        )
     return EXIT_OK
 
 
 def cmd_infer(args) -> int:
     if args.kind != "schema":
-        print(f"bgr infer: --kind {args.kind} is not written yet; --kind schema is", file=sys.stderr)
+        print(
+            f"bgr infer: --kind {args.kind} is not written yet; --kind schema is", file=sys.stderr
+        )
         return EXIT_INPUT
     fixed: dict[str, bool] = {}
     for option, value in (("--fixed", True), ("--stretch", False)):
         for label in filter(None, (x.strip() for x in getattr(args, option[2:]).split(","))):
             if fixed.get(label, value) != value:
-                print(f"bgr infer: label '{label}' is given to both --fixed and --stretch", file=sys.stderr)
+                print(
+                    f"bgr infer: label '{label}' is given to both --fixed and --stretch",
+                    file=sys.stderr,
+                )
                 return EXIT_USAGE
             fixed[label] = value
     from .inverse.schema import infer
@@ -273,7 +381,9 @@ def cmd_render(args) -> int:
     if args.size is not None:
         size = _parse_size(args.size)
         if size is None:
-            return usage(f"--size {args.size}: write WIDTHxHEIGHT, e.g. 1024x768 (1 to 16384 pixels each)")
+            return usage(
+                f"--size {args.size}: write WIDTHxHEIGHT, e.g. 1024x768 (1 to 16384 pixels each)"
+            )
     if args.view not in VIEWS and not args.view.lower().endswith(".json"):
         return usage(f"--view {args.view}: give {', '.join(VIEWS)} or a camera file CAMERA.json")
     if args.legend and args.mode != "labels":
@@ -291,11 +401,21 @@ def cmd_render(args) -> int:
         attrs[name.strip()] = _parse_value(value.strip())
     out = Path(args.output)
     if out.suffix.lower() != ".png":  # before deriving: a typo should not cost a derivation
-        shown = f"unknown output extension '{out.suffix}'" if out.suffix else "the output file name has no extension"
+        shown = (
+            f"unknown output extension '{out.suffix}'"
+            if out.suffix
+            else "the output file name has no extension"
+        )
         raise BgrError(Diagnostic(args.output, 0, 0, shown, "bgr render writes .png files"))
 
-    scene = load_scene(args.file, seed=args.seed or 0, attrs=attrs, lot=args.lot,
-                       max_depth=args.max_depth, max_shapes=args.max_shapes)
+    scene = load_scene(
+        args.file,
+        seed=args.seed or 0,
+        attrs=attrs,
+        lot=args.lot,
+        max_depth=args.max_depth,
+        max_shapes=args.max_shapes,
+    )
     camera = make_camera(args.view, scene, size)
 
     def fallback(reason: str) -> None:
@@ -308,13 +428,20 @@ def cmd_render(args) -> int:
         save_legend(legend, legend_path(out))
     width, height = camera.size
     view = args.view if args.view in VIEWS else Path(args.view).name
-    print(f"{args.output}: {width}x{height} {args.mode}, view {view}, {len(scene):,} triangles ({frame.backend})",
-          file=sys.stderr)
+    print(
+        f"{args.output}: {width}x{height} {args.mode}, view {view}, {len(scene):,} triangles ({frame.backend})",
+        file=sys.stderr,
+    )
     return EXIT_OK
 
 
-COMMANDS = {"check": cmd_check, "fmt": cmd_fmt, "derive": cmd_derive, "render": cmd_render,
-            "infer": cmd_infer}
+COMMANDS = {
+    "check": cmd_check,
+    "fmt": cmd_fmt,
+    "derive": cmd_derive,
+    "render": cmd_render,
+    "infer": cmd_infer,
+}
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -337,8 +464,11 @@ def main(argv: list[str] | None = None) -> int:
     except Exception as e:  # a bug of ours: say so without a traceback unless asked
         if os.environ.get("BGR_DEBUG"):
             traceback.print_exc()
-        print(f"bgr: internal error: {type(e).__name__}: {e} (please report it; "
-              "BGR_DEBUG=1 shows the traceback)", file=sys.stderr)
+        print(
+            f"bgr: internal error: {type(e).__name__}: {e} (please report it; "
+            "BGR_DEBUG=1 shows the traceback)",
+            file=sys.stderr,
+        )
         return EXIT_INPUT
 
 

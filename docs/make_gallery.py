@@ -42,17 +42,28 @@ EXAMPLES = [
 # How a thumbnail shows each module's rules: a wrapper rule applying lib.NAME, and the view.
 WRAPPERS = {
     "mass": (None, "iso"),
-    "facade": ("Lot --> s(14, 0, 1) extrude(11) comp(f) {{ front: lib.{name} | all: NIL }}", "front"),
-    "window": ("Lot --> s(1.4, 0, 1) extrude(2.2) comp(f) {{ front: lib.{name} | all: NIL }}", "iso"),
-    "roof": ("Lot --> s(12, 0, 9) extrude(4) comp(f) {{ top: lib.{name} | side: color(\"#d8c8a8\") W "
-             "| all: NIL }}\nterminal W", "iso"),
+    "facade": (
+        "Lot --> s(14, 0, 1) extrude(11) comp(f) {{ front: lib.{name} | all: NIL }}",
+        "front",
+    ),
+    "window": (
+        "Lot --> s(1.4, 0, 1) extrude(2.2) comp(f) {{ front: lib.{name} | all: NIL }}",
+        "iso",
+    ),
+    "roof": (
+        'Lot --> s(12, 0, 9) extrude(4) comp(f) {{ top: lib.{name} | side: color("#d8c8a8") W '
+        "| all: NIL }}\nterminal W",
+        "iso",
+    ),
 }
 ENTRANCE = "Lot --> s(2.2, 0, 1) extrude(3) comp(f) {{ front: lib.{name} | all: NIL }}"
 
 
 def quantised(image: np.ndarray) -> np.ndarray:
     """The image with at most 128 colours: a third of the bytes, no visible change at this size."""
-    pic = Image.fromarray(image).quantize(colors=128, method=Image.Quantize.MEDIANCUT, dither=Image.Dither.NONE)
+    pic = Image.fromarray(image).quantize(
+        colors=128, method=Image.Quantize.MEDIANCUT, dither=Image.Dither.NONE
+    )
     return np.asarray(pic.convert("RGB"))
 
 
@@ -67,8 +78,17 @@ def examples() -> None:
         scene = load_scene(ROOT / "examples" / name, seed=seed, lot=lot_arg)
         if isinstance(view, tuple):
             lo, hi = scene.bounds()
-            view = fit(Camera(35.0, rotation_from_angles(view[0], view[1], 0.0), np.zeros(3), (0.0, 0.0),
-                              EXAMPLE_SIZE), lo, hi)
+            view = fit(
+                Camera(
+                    35.0,
+                    rotation_from_angles(view[0], view[1], 0.0),
+                    np.zeros(3),
+                    (0.0, 0.0),
+                    EXAMPLE_SIZE,
+                ),
+                lo,
+                hi,
+            )
         image = render(scene, "shaded", view, EXAMPLE_SIZE)
         save(image, DOCS / "img" / "examples" / (Path(name).stem + ".png"))
         print(f"  examples/{name}", file=sys.stderr)
@@ -80,10 +100,16 @@ def captured() -> None:
     from bgr.inverse.schema import infer
 
     folder = ROOT / "examples" / "captured"
-    grammar = bgr.load(bgr.format_module(infer(folder / "corner_shop.json")), path=folder / "corner_shop.bgr")
+    grammar = bgr.load(
+        bgr.format_module(infer(folder / "corner_shop.json")), path=folder / "corner_shop.bgr"
+    )
     before = render(bgr.derive(grammar, lot=(18, 12)), "shaded", "iso", EXAMPLE_SIZE)
-    after = render(bgr.derive(grammar, lot=str(folder / "l_lot.geojson"), attrs={"height": 18.8}),
-                   "shaded", "iso", EXAMPLE_SIZE)
+    after = render(
+        bgr.derive(grammar, lot=str(folder / "l_lot.geojson"), attrs={"height": 18.8}),
+        "shaded",
+        "iso",
+        EXAMPLE_SIZE,
+    )
     save(np.hstack([before, after]), folder / "before_after.png")
     print("  examples/captured/before_after.png", file=sys.stderr)
 
@@ -93,7 +119,9 @@ def thumbnail(module: str, rule: str) -> np.ndarray:
     if module == "window" and rule.endswith("Entrance"):
         template = ENTRANCE
     if template is None:  # a mass takes the lot itself
-        grammar = bgr.load(f"import stdlib.{module} as lib\nLot --> lib.{rule}\n", path=ROOT / "_gallery.bgr")
+        grammar = bgr.load(
+            f"import stdlib.{module} as lib\nLot --> lib.{rule}\n", path=ROOT / "_gallery.bgr"
+        )
         result = bgr.derive(grammar, seed=1, lot=(20, 15))
     else:
         src = f"import stdlib.{module} as lib\n{template.format(name=rule)}\n"

@@ -13,14 +13,39 @@ from dataclasses import dataclass, field
 from . import nodes as n
 from .errors import Diagnostic, source_line, suggest
 from .formatter import format_params
-from .registry import (AXES, AXIS, AXIS_NAMES, BUILTIN_NAMES, BUILTINS, COLOR, COMP_KIND, COMP_KINDS,
-                       COMP_SELECTORS, GEOMETRY, KEYWORDS, NUMBER, OFFSET_SELECTORS, OPERATIONS,
-                       PRIMITIVES, ROOF_KIND, ROOF_KINDS, SIZE, STRING, Op, FOOTPRINT_KIND, FOOTPRINT_KINDS)
+from .registry import (
+    AXES,
+    AXIS,
+    AXIS_NAMES,
+    BUILTIN_NAMES,
+    BUILTINS,
+    COLOR,
+    COMP_KIND,
+    COMP_KINDS,
+    COMP_SELECTORS,
+    GEOMETRY,
+    KEYWORDS,
+    NUMBER,
+    OFFSET_SELECTORS,
+    OPERATIONS,
+    PRIMITIVES,
+    ROOF_KIND,
+    ROOF_KINDS,
+    SIZE,
+    STRING,
+    Op,
+    FOOTPRINT_KIND,
+    FOOTPRINT_KINDS,
+)
 
 KNOWN_VERSIONS = (1,)
 _COLOR_RE = re.compile(r"#[0-9a-fA-F]{6}\Z")
-_SYMBOL_KINDS = {AXIS: AXIS_NAMES, COMP_KIND: COMP_KINDS, ROOF_KIND: ROOF_KINDS,
-                 FOOTPRINT_KIND: FOOTPRINT_KINDS}
+_SYMBOL_KINDS = {
+    AXIS: AXIS_NAMES,
+    COMP_KIND: COMP_KINDS,
+    ROOF_KIND: ROOF_KINDS,
+    FOOTPRINT_KIND: FOOTPRINT_KINDS,
+}
 _RESERVED_ALIASES = {"scope", "split", "comp", "stdlib"}
 
 
@@ -64,11 +89,22 @@ class Checker:
         self.broken_aliases = set(k for k, bad in (import_errors or {}).items() if bad)
 
     # ---- reporting ------------------------------------------------------------------------
-    def error(self, pos: n.Pos, message: str, hint: str | None = None, length: int | None = None) -> None:
+    def error(
+        self, pos: n.Pos, message: str, hint: str | None = None, length: int | None = None
+    ) -> None:
         if length is None:
             length = pos.end_column - pos.column if pos.end_line == pos.line else 1
-        self.diagnostics.append(Diagnostic(self.g.path, pos.line, pos.column, message, hint,
-                                           source_line(self.source, pos.line), max(length, 1)))
+        self.diagnostics.append(
+            Diagnostic(
+                self.g.path,
+                pos.line,
+                pos.column,
+                message,
+                hint,
+                source_line(self.source, pos.line),
+                max(length, 1),
+            )
+        )
 
     # ---- entry point ----------------------------------------------------------------------
     def check(self) -> list[Diagnostic]:
@@ -90,13 +126,19 @@ class Checker:
 
         def declare(space: str, name: str, pos: n.Pos, what: str) -> bool:
             if name in KEYWORDS:
-                self.error(pos, f"'{name}' is a keyword and cannot name {_article(what)}",
-                           "choose another name")
+                self.error(
+                    pos,
+                    f"'{name}' is a keyword and cannot name {_article(what)}",
+                    "choose another name",
+                )
                 return False
             key = (space, name)
             if key in first_seen:
-                self.error(pos, f"duplicate {what} '{name}'",
-                           f"'{name}' is already defined on line {first_seen[key].line}")
+                self.error(
+                    pos,
+                    f"duplicate {what} '{name}'",
+                    f"'{name}' is already defined on line {first_seen[key].line}",
+                )
                 return False
             first_seen[key] = pos
             return True
@@ -109,14 +151,21 @@ class Checker:
                     self.error(item.pos, "more than one 'version' declaration")
                 elif item.number not in KNOWN_VERSIONS:
                     shown = int(item.number) if item.number.is_integer() else item.number
-                    self.error(item.pos, f"unknown language version {shown}",
-                               "this bgr reads version 1: write 'version 1' or leave the line out")
+                    self.error(
+                        item.pos,
+                        f"unknown language version {shown}",
+                        "this bgr reads version 1: write 'version 1' or leave the line out",
+                    )
                 else:
                     g.version = int(item.number)
             elif isinstance(item, n.Rule):
                 if item.name in OPERATIONS:
-                    self.error(item.pos, f"'{item.name}' is an operation and cannot name a rule",
-                               "choose another name, e.g. a capitalised one", len(item.name))
+                    self.error(
+                        item.pos,
+                        f"'{item.name}' is an operation and cannot name a rule",
+                        "choose another name, e.g. a capitalised one",
+                        len(item.name),
+                    )
                 elif declare("rule", item.name, item.pos, "rule"):
                     g.rules[item.name] = item
                 self.unique_params(item, "rule")
@@ -127,25 +176,34 @@ class Checker:
             elif isinstance(item, (n.Attr, n.Const)):
                 what = "attr" if isinstance(item, n.Attr) else "const"
                 if item.name in BUILTIN_NAMES:
-                    self.error(item.pos, f"'{item.name}' is a built-in name and cannot be redefined")
+                    self.error(
+                        item.pos, f"'{item.name}' is a built-in name and cannot be redefined"
+                    )
                 elif declare("value", item.name, item.pos, "attr or const"):
                     (g.attrs if what == "attr" else g.consts)[item.name] = item
             elif isinstance(item, n.Func):
                 if item.name in BUILTINS:
-                    self.error(item.pos, f"'{item.name}' is a built-in function and cannot be redefined")
+                    self.error(
+                        item.pos, f"'{item.name}' is a built-in function and cannot be redefined"
+                    )
                 elif declare("func", item.name, item.pos, "func"):
                     g.funcs[item.name] = item
                 self.unique_params(item, "func")
             elif isinstance(item, n.Asset):
                 if item.name in PRIMITIVES:
-                    self.error(item.pos, f"'{item.name}' is a built-in primitive and cannot name an asset")
+                    self.error(
+                        item.pos, f"'{item.name}' is a built-in primitive and cannot name an asset"
+                    )
                 elif declare("asset", item.name, item.pos, "asset"):
                     g.assets[item.name] = item
             elif isinstance(item, n.Import):
                 where = item.alias_pos if item.alias_pos.line else item.pos
                 if item.alias in _RESERVED_ALIASES:
-                    self.error(where, f"'{item.alias}' is reserved and cannot be an import alias",
-                               f"write e.g. 'as {item.alias[:3]}_lib'")
+                    self.error(
+                        where,
+                        f"'{item.alias}' is reserved and cannot be an import alias",
+                        f"write e.g. 'as {item.alias[:3]}_lib'",
+                    )
                 else:
                     declare("alias", item.alias, where, "import alias")
             elif isinstance(item, n.Start):
@@ -157,7 +215,9 @@ class Checker:
         # the start rule is checked once every rule is known
         for item in g.module.items:
             if isinstance(item, n.Start) and item.name == g.start and item.name not in g.rules:
-                hint = suggest(item.name, g.rules) or ("the file has no rules" if not g.rules else None)
+                hint = suggest(item.name, g.rules) or (
+                    "the file has no rules" if not g.rules else None
+                )
                 self.error(item.pos, f"start rule '{item.name}' is not defined", hint)
                 break
         if g.start is None and g.rules:
@@ -180,9 +240,12 @@ class Checker:
                 if item.default(i) is not None:
                     defaulted = True
                 elif defaulted:
-                    self.error(pos, f"parameter '{p}' has no default but follows one that has",
-                               f"give it a default ('{p} = ...') or move it before the defaulted ones",
-                               len(p))
+                    self.error(
+                        pos,
+                        f"parameter '{p}' has no default but follows one that has",
+                        f"give it a default ('{p} = ...') or move it before the defaulted ones",
+                        len(p),
+                    )
 
     # ---- rules ----------------------------------------------------------------------------
     def rule(self, rule: n.Rule) -> None:
@@ -206,8 +269,11 @@ class Checker:
                         self.error(choice.prob.pos, "a probability cannot be negative")
                     total += choice.prob.value
                     if total > 100 + 1e-9:
-                        self.error(choice.prob.pos, f"the percentages add up to {total:g}%, over 100%",
-                                   "the choices of one rule share 100%; 'else' takes what is left")
+                        self.error(
+                            choice.prob.pos,
+                            f"the percentages add up to {total:g}%, over 100%",
+                            "the choices of one rule share 100%; 'else' takes what is left",
+                        )
                 self.sequence(choice.body, local)
         else:
             for case in body.cases:
@@ -245,10 +311,16 @@ class Checker:
         if step.name in local:  # a parameter that holds a rule: checked when it is applied
             return
         keyword = next((a for a in step.args if isinstance(a, n.Keyword)), None)
-        if step.name in OPERATIONS and keyword is not None:  # `extrude(h = 3)`: left to us by the parser
-            self.error(keyword.pos, f"operation '{step.name}' takes no keyword arguments",
-                       f"write the value alone, without '{keyword.name} =' (or, if '{step.name}' is a "
-                       "parameter holding a rule, declare it in the rule's head)", len(keyword.name))
+        if (
+            step.name in OPERATIONS and keyword is not None
+        ):  # `extrude(h = 3)`: left to us by the parser
+            self.error(
+                keyword.pos,
+                f"operation '{step.name}' takes no keyword arguments",
+                f"write the value alone, without '{keyword.name} =' (or, if '{step.name}' is a "
+                "parameter holding a rule, declare it in the rule's head)",
+                len(keyword.name),
+            )
             return
         module, member = self.g.lookup_module(step.name)
         if module is not self.g or "." in step.name:
@@ -265,11 +337,17 @@ class Checker:
                 self.error(pos or step.pos, message, hint, None if pos else len(step.name))
         elif member in module.terminals:
             if step.args:
-                self.error(step.pos, f"terminal '{step.name}' takes no arguments", length=len(step.name))
+                self.error(
+                    step.pos, f"terminal '{step.name}' takes no arguments", length=len(step.name)
+                )
         elif module is self.g and member in OPERATIONS:
             op = OPERATIONS[member]
-            self.error(step.pos, f"operation '{member}' needs its arguments", f"write {op.usage()}",
-                       len(member))
+            self.error(
+                step.pos,
+                f"operation '{member}' needs its arguments",
+                f"write {op.usage()}",
+                len(member),
+            )
         else:
             known = list(module.rules) + list(module.terminals)
             if module is self.g:
@@ -286,7 +364,9 @@ class Checker:
             self.error(step.pos, f"{where} '{member}'", hint, len(step.name))
 
     def unknown_alias(self, alias: str, pos: n.Pos) -> None:
-        hint = suggest(alias, self.g.imports) or f"import it first: import stdlib.{alias} as {alias}"
+        hint = (
+            suggest(alias, self.g.imports) or f"import it first: import stdlib.{alias} as {alias}"
+        )
         self.error(pos, f"unknown module '{alias}'", hint, len(alias))
 
     # ---- operations -----------------------------------------------------------------------
@@ -304,14 +384,21 @@ class Checker:
                 self.error(step.block.pos, f"'{op.name}' takes no {{ }} block")
             return
         if step.block is None:
-            self.error(step.pos, f"'{op.name}' needs a {{ ... }} block", f"for example: {op.example}",
-                       len(op.name))
+            self.error(
+                step.pos,
+                f"'{op.name}' needs a {{ ... }} block",
+                f"for example: {op.example}",
+                len(op.name),
+            )
             return
         if step.block.repeat and op.block != "split":
             end = step.block.pos
             star = n.Pos(end.end_line, end.end_column - 1, end.end_line, end.end_column)
-            self.error(star, f"only split blocks repeat; '{op.name}' {{ ... }} cannot take a '*'",
-                       "remove the '*'")
+            self.error(
+                star,
+                f"only split blocks repeat; '{op.name}' {{ ... }} cannot take a '*'",
+                "remove the '*'",
+            )
         self.block_entries(step.block.entries, op, local, in_group=False)
 
     def pick_signature(self, op: Op, step: n.Operation):
@@ -321,26 +408,40 @@ class Checker:
                 return sig
         counts = " or ".join(str(a) if a == b else f"{a} to {b}" for a, b in op.arities())
         noun = "argument" if counts == "1" else "arguments"
-        self.error(step.pos, f"'{op.name}' takes {counts} {noun}, given {count}",
-                   f"write {op.usage()}", len(op.name))
+        self.error(
+            step.pos,
+            f"'{op.name}' takes {counts} {noun}, given {count}",
+            f"write {op.usage()}",
+            len(op.name),
+        )
         return None
 
     def op_arg(self, arg, kind: str, pname: str, op: Op, local: set[str]) -> None:
         if kind in _SYMBOL_KINDS or kind in (AXES, GEOMETRY):
             if not isinstance(arg, n.Name):
                 allowed = self.allowed_symbols(kind)
-                self.error(arg.pos, f"the {pname} of '{op.name}' is a bare word, one of {allowed}",
-                           f"for example: {op.example}")
+                self.error(
+                    arg.pos,
+                    f"the {pname} of '{op.name}' is a bare word, one of {allowed}",
+                    f"for example: {op.example}",
+                )
                 return
             word = arg.name
             if kind in _SYMBOL_KINDS:
                 if word not in _SYMBOL_KINDS[kind]:
-                    self.error(arg.pos, f"unknown {kind} '{word}'",
-                               suggest(word, _SYMBOL_KINDS[kind]) or f"use one of {self.allowed_symbols(kind)}")
+                    self.error(
+                        arg.pos,
+                        f"unknown {kind} '{word}'",
+                        suggest(word, _SYMBOL_KINDS[kind])
+                        or f"use one of {self.allowed_symbols(kind)}",
+                    )
             elif kind == AXES:
                 if not word or set(word) - set("xyz") or len(set(word)) != len(word):
-                    self.error(arg.pos, f"'{word}' is not a set of axes",
-                               "write the axes as one word of x, y and z, e.g. center(xz)")
+                    self.error(
+                        arg.pos,
+                        f"'{word}' is not a set of axes",
+                        "write the axes as one word of x, y and z, e.g. center(xz)",
+                    )
             else:  # GEOMETRY
                 module, member = self.g.lookup_module(word)
                 if member in PRIMITIVES and module is self.g:
@@ -349,27 +450,42 @@ class Checker:
                     return
                 if member not in module.assets:
                     known = list(PRIMITIVES) + list(self.g.assets)
-                    self.error(arg.pos, f"unknown primitive or asset '{word}'",
-                               suggest(word, known) or "declare it: asset NAME = \"path/to/mesh.glb\"")
+                    self.error(
+                        arg.pos,
+                        f"unknown primitive or asset '{word}'",
+                        suggest(word, known) or 'declare it: asset NAME = "path/to/mesh.glb"',
+                    )
             return
         if isinstance(arg, n.Relative) and kind != SIZE:
-            self.error(arg.pos, f"a relative size ('f) is not allowed as the {pname} of '{op.name}'",
-                       "relative sizes go in s(), t() and split sizes")
+            self.error(
+                arg.pos,
+                f"a relative size ('f) is not allowed as the {pname} of '{op.name}'",
+                "relative sizes go in s(), t() and split sizes",
+            )
             return
         self.arg(arg, local, relative_ok=True)
         expr = arg.expr if isinstance(arg, n.Relative) else arg
         if kind in (NUMBER, SIZE) and isinstance(expr, (n.String, n.Bool)):
             self.error(expr.pos, f"the {pname} of '{op.name}' must be a number")
         elif kind == STRING and isinstance(expr, (n.Number, n.Bool)):
-            self.error(expr.pos, f"the {pname} of '{op.name}' must be a string",
-                       f"for example: {op.example}")
+            self.error(
+                expr.pos,
+                f"the {pname} of '{op.name}' must be a string",
+                f"for example: {op.example}",
+            )
         elif kind == COLOR:
             if isinstance(expr, n.String) and not _COLOR_RE.match(expr.value):
-                self.error(expr.pos, f"'{expr.value}' is not a colour",
-                           'write "#rrggbb" with six hexadecimal digits, or three numbers in 0..1')
+                self.error(
+                    expr.pos,
+                    f"'{expr.value}' is not a colour",
+                    'write "#rrggbb" with six hexadecimal digits, or three numbers in 0..1',
+                )
             elif isinstance(expr, (n.Number, n.Bool)):
-                self.error(expr.pos, "a single colour argument is a \"#rrggbb\" string",
-                           "or give three numbers: color(r, g, b)")
+                self.error(
+                    expr.pos,
+                    'a single colour argument is a "#rrggbb" string',
+                    "or give three numbers: color(r, g, b)",
+                )
 
     def allowed_symbols(self, kind: str) -> str:
         if kind == AXES:
@@ -382,7 +498,10 @@ class Checker:
         for entry in entries:
             if isinstance(entry, n.Group):
                 if op.block != "split":
-                    self.error(entry.pos, f"repeat groups {{ ... }}* belong in split blocks, not in '{op.name}'")
+                    self.error(
+                        entry.pos,
+                        f"repeat groups {{ ... }}* belong in split blocks, not in '{op.name}'",
+                    )
                 else:
                     self.block_entries(entry.entries, op, local, in_group=True)
                 continue
@@ -398,8 +517,11 @@ class Checker:
         allowed = COMP_SELECTORS if op.block == "comp" else OFFSET_SELECTORS
         key = entry.key
         if entry.kind != "abs":
-            self.error(entry.pos, f"'{op.name}' selectors have no size prefix",
-                       f"write e.g. '{allowed[0]}: A'")
+            self.error(
+                entry.pos,
+                f"'{op.name}' selectors have no size prefix",
+                f"write e.g. '{allowed[0]}: A'",
+            )
             return
         if isinstance(key, n.Name) and key.name in allowed:
             return
@@ -412,8 +534,11 @@ class Checker:
         word = key.name if isinstance(key, (n.Name, n.Call)) else None
         extra = ", face(i)" if op.block == "comp" else ""
         hint = suggest(word, allowed) if word else None
-        self.error(key.pos, f"unknown {op.name} selector" + (f" '{word}'" if word else ""),
-                   hint or f"use one of {', '.join(allowed)}{extra}")
+        self.error(
+            key.pos,
+            f"unknown {op.name} selector" + (f" '{word}'" if word else ""),
+            hint or f"use one of {', '.join(allowed)}{extra}",
+        )
 
     # ---- expressions ----------------------------------------------------------------------
     def arg(self, arg, local: set[str], relative_ok: bool) -> None:
@@ -421,8 +546,11 @@ class Checker:
             self.expr(arg.value, local, in_rule=True)
         elif isinstance(arg, n.Relative):
             if not relative_ok:
-                self.error(arg.pos, "a relative size ('f) is not allowed here",
-                           "relative sizes go in s(), t() and split sizes")
+                self.error(
+                    arg.pos,
+                    "a relative size ('f) is not allowed here",
+                    "relative sizes go in s(), t() and split sizes",
+                )
             self.expr(arg.expr, local, in_rule=True)
         else:
             self.expr(arg, local, in_rule=True)
@@ -452,8 +580,11 @@ class Checker:
             return
         if name in BUILTIN_NAMES:
             if not in_rule and name != "seed":
-                self.error(e.pos, f"'{name}' is only known while deriving a shape",
-                           "use it in a rule or a func, not in an attr or const")
+                self.error(
+                    e.pos,
+                    f"'{name}' is only known while deriving a shape",
+                    "use it in a rule or a func, not in an attr or const",
+                )
             return
         if "." in name:
             alias, member = name.split(".", 1)
@@ -464,8 +595,11 @@ class Checker:
                 if member in module.attrs or member in module.consts:
                     return
                 if member in module.rules or member in module.terminals:
-                    self.error(e.pos, f"'{name}' is a rule, not a value",
-                               "a rule can only be handed whole to a rule parameter: R(part = Name)")
+                    self.error(
+                        e.pos,
+                        f"'{name}' is a rule, not a value",
+                        "a rule can only be handed whole to a rule parameter: R(part = Name)",
+                    )
                     return
                 if member[:1].isupper():  # most likely a rule handed to a parameter
                     hint = suggest(member, list(module.rules) + list(module.terminals))
@@ -476,18 +610,27 @@ class Checker:
                 return
             if alias in ("scope", "split", "comp"):
                 known = [k for k in BUILTIN_NAMES if k.startswith(alias + ".")]
-                self.error(e.pos, f"unknown name '{name}'", suggest(name, known) or f"known: {', '.join(known)}")
+                self.error(
+                    e.pos,
+                    f"unknown name '{name}'",
+                    suggest(name, known) or f"known: {', '.join(known)}",
+                )
                 return
             self.unknown_alias(alias, e.pos)
             return
         if name in self.g.rules or name in self.g.terminals:
-            self.error(e.pos, f"'{name}' is a rule, not a value",
-                       "a rule can only be handed whole to a rule parameter: R(part = Name)")
+            self.error(
+                e.pos,
+                f"'{name}' is a rule, not a value",
+                "a rule can only be handed whole to a rule parameter: R(part = Name)",
+            )
             return
         known = list(local) + list(self.g.attrs) + list(self.g.consts) + list(BUILTIN_NAMES)
         hint = suggest(name, known)
         if hint is None and (name in AXIS_NAMES or name in ROOF_KINDS or name in PRIMITIVES):
-            hint = "bare words like this are only arguments of split, roof, i and similar operations"
+            hint = (
+                "bare words like this are only arguments of split, roof, i and similar operations"
+            )
         self.error(e.pos, f"unknown name '{name}'", hint, len(name))
 
     def call(self, e: n.Call) -> None:
@@ -495,11 +638,18 @@ class Checker:
         if name in BUILTINS:
             b = BUILTINS[name]
             if count < b.least or (b.most is not None and count > b.most):
-                want = str(b.least) if b.least == b.most else (
-                    f"{b.least} or more" if b.most is None else f"{b.least} to {b.most}")
+                want = (
+                    str(b.least)
+                    if b.least == b.most
+                    else (f"{b.least} or more" if b.most is None else f"{b.least} to {b.most}")
+                )
                 noun = "argument" if want == "1" else "arguments"
-                self.error(e.pos, f"'{name}' takes {want} {noun}, given {count}", f"{b.usage}: {b.doc}",
-                           len(name))
+                self.error(
+                    e.pos,
+                    f"'{name}' takes {want} {noun}, given {count}",
+                    f"{b.usage}: {b.doc}",
+                    len(name),
+                )
             return
         module, member = self.g.lookup_module(name)
         if "." in name and name.split(".", 1)[0] in self.broken_aliases:
@@ -510,12 +660,19 @@ class Checker:
         if member in module.funcs:
             params = module.funcs[member].params
             if count != len(params):
-                self.error(e.pos, f"function '{name}' takes {_count(len(params), 'argument')}, given {count}",
-                           f"it is declared as {member}({', '.join(params)})", len(name))
+                self.error(
+                    e.pos,
+                    f"function '{name}' takes {_count(len(params), 'argument')}, given {count}",
+                    f"it is declared as {member}({', '.join(params)})",
+                    len(name),
+                )
             return
         if module is self.g and name in OPERATIONS:
-            self.error(e.pos, f"'{name}' is an operation, not a function; it cannot be used in an expression",
-                       length=len(name))
+            self.error(
+                e.pos,
+                f"'{name}' is an operation, not a function; it cannot be used in an expression",
+                length=len(name),
+            )
             return
         if module is self.g and (name in self.g.rules or name in self.g.terminals):
             self.error(e.pos, f"'{name}' is a rule, not a function", length=len(name))
@@ -526,7 +683,10 @@ class Checker:
     def value_cycles(self) -> None:
         """attr a = b + 1; attr b = a: report a definition cycle among attrs and consts."""
         values = {**self.g.attrs, **self.g.consts}
-        deps = {name: {x.name for x in n.names_in(item.value) if x.name in values} for name, item in values.items()}
+        deps = {
+            name: {x.name for x in n.names_in(item.value) if x.name in values}
+            for name, item in values.items()
+        }
         state: dict[str, int] = {}
         for root in deps:
             if state.get(root):
@@ -542,9 +702,11 @@ class Checker:
                     stack.pop()
                     path.pop()
                 elif state.get(child) == 1:
-                    cycle = path[path.index(child):] + [child]
-                    self.error(values[child].pos, "attrs and consts define each other in a cycle: "
-                               + " -> ".join(cycle))
+                    cycle = path[path.index(child) :] + [child]
+                    self.error(
+                        values[child].pos,
+                        "attrs and consts define each other in a cycle: " + " -> ".join(cycle),
+                    )
                     state[child] = 2
                 elif not state.get(child):
                     state[child] = 1
@@ -564,13 +726,20 @@ def bind_problem(rule: n.Rule, args: list, called: str):
     handed over in a parameter, which the checker cannot see.
     """
     params = rule.params
-    want = f"it is declared as {rule.name}{format_params(rule)}" if params else f"'{rule.name}' takes no arguments"
+    want = (
+        f"it is declared as {rule.name}{format_params(rule)}"
+        if params
+        else f"'{rule.name}' takes no arguments"
+    )
     positional = [a for a in args if not isinstance(a, n.Keyword)]
     plain = not rule.defaults and len(positional) == len(args)
     if len(positional) > len(params) or (plain and len(positional) != len(params)):
-        return None, (f"rule '{called}' takes {_count(len(params), 'argument')}, "
-                      f"given {len(positional)}"), want
-    bound = set(params[:len(positional)])
+        return (
+            None,
+            (f"rule '{called}' takes {_count(len(params), 'argument')}, given {len(positional)}"),
+            want,
+        )
+    bound = set(params[: len(positional)])
     for arg in args:
         if not isinstance(arg, n.Keyword):
             continue

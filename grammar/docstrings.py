@@ -35,7 +35,7 @@ def _text(comment: n.Comment) -> str:
     text = comment.text
     for mark in ("#", "//"):
         if text.startswith(mark):
-            return text[len(mark):].rstrip()
+            return text[len(mark) :].rstrip()
     return text.rstrip()
 
 
@@ -57,7 +57,7 @@ def rule_docs(module: n.Module) -> dict[str, RuleDoc]:
 def parse_doc(name: str, lines: list[str]) -> RuleDoc:
     first = lines[0].strip()
     named = first.startswith(name + ":")
-    summary = [first[len(name) + 1:].strip() if named else first]
+    summary = [first[len(name) + 1 :].strip() if named else first]
     params: dict[str, str] = {}
     for raw in lines[1:]:
         m = _PARAM.match(raw)
@@ -70,7 +70,9 @@ def parse_doc(name: str, lines: list[str]) -> RuleDoc:
 
 def module_header(module: n.Module) -> str:
     """The comment block at the top of a file, before its first declaration or rule."""
-    first_item = min((item.pos.line for item in module.items if getattr(item, "pos", None)), default=10**9)
+    first_item = min(
+        (item.pos.line for item in module.items if getattr(item, "pos", None)), default=10**9
+    )
     out = []
     for c in sorted(module.comments, key=lambda c: c.line):
         if c.line >= first_item or not c.own_line:

@@ -105,4 +105,6 @@ def read_json(path, what: str, hint: str | None = None):
     except (OSError, UnicodeDecodeError) as exc:
         raise BgrError(Diagnostic(shown, 0, 0, f"cannot read the {what}: {exc}")) from None
     except json.JSONDecodeError as exc:
-        raise BgrError(Diagnostic(shown, exc.lineno, exc.colno, f"not valid JSON: {exc.msg}")) from None
+        raise BgrError(
+            Diagnostic(shown, exc.lineno, exc.colno, f"not valid JSON: {exc.msg}")
+        ) from None

@@ -25,17 +25,34 @@ from . import nodes as n
 from .errors import BgrError, Diagnostic, source_lines
 
 WIDTH = 100
-HEAD_WIDTH = 60  # a rule head (name, parameters, arrow) longer than this lists one parameter per line
+HEAD_WIDTH = (
+    60  # a rule head (name, parameters, arrow) longer than this lists one parameter per line
+)
 INDENT = "    "
 
 # Precedence levels, loosest first; they mirror the tree builder's binding powers.
-_LEVEL = {"or": 1, "and": 2, "==": 4, "!=": 4, "<": 4, "<=": 4, ">": 4, ">=": 4,
-          "+": 5, "-": 5, "*": 6, "/": 6, "%": 6, "**": 8}
+_LEVEL = {
+    "or": 1,
+    "and": 2,
+    "==": 4,
+    "!=": 4,
+    "<": 4,
+    "<=": 4,
+    ">": 4,
+    ">=": 4,
+    "+": 5,
+    "-": 5,
+    "*": 6,
+    "/": 6,
+    "%": 6,
+    "**": 8,
+}
 _UNARY_LEVEL = {"not": 3, "-": 7, "+": 7}
 _ATOM = 9
 
 
 # ---- expressions --------------------------------------------------------------------------------
+
 
 def format_number(value: float) -> str:
     if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
@@ -48,7 +65,9 @@ def format_number(value: float) -> str:
 def format_string(value: str) -> str:
     if "\x00" in value:
         raise ValueError("a .bgr string cannot hold a NUL character")
-    escaped = value.replace("\\", "\\\\").replace('"', '\\"').replace("\n", "\\n").replace("\t", "\\t")
+    escaped = (
+        value.replace("\\", "\\\\").replace('"', '\\"').replace("\n", "\\n").replace("\t", "\\t")
+    )
     return f'"{escaped}"'
 
 
@@ -110,7 +129,9 @@ def format_expr(e) -> str:
 
 def _is_signed(e) -> bool:
     """A prefix ``-``/``+`` term or a negative number: it binds only ``**`` to its right."""
-    return (isinstance(e, n.Unary) and e.op in ("-", "+")) or (isinstance(e, n.Number) and _level(e) == 7)
+    return (isinstance(e, n.Unary) and e.op in ("-", "+")) or (
+        isinstance(e, n.Number) and _level(e) == 7
+    )
 
 
 def format_arg(a) -> str:
@@ -138,6 +159,7 @@ def _guarded(e) -> str:
 
 # ---- layout -------------------------------------------------------------------------------------
 
+
 @dataclass
 class Line:
     text: str
@@ -164,7 +186,9 @@ class _Writer:
 
     def flush(self) -> None:
         if self.parts:
-            self.lines.append(Line("".join(self.parts).rstrip(), self.anchor, self.indent, self.top))
+            self.lines.append(
+                Line("".join(self.parts).rstrip(), self.anchor, self.indent, self.top)
+            )
         self.parts = []
 
 
@@ -231,7 +255,10 @@ class Formatter:
             for i, p in enumerate(rule.params):
                 out.start(rule.pos.line, 1)
                 d = rule.default(i)
-                out.write((p if d is None else f"{p} = {format_expr(d)}") + ("," if i < len(rule.params) - 1 else ""))
+                out.write(
+                    (p if d is None else f"{p} = {format_expr(d)}")
+                    + ("," if i < len(rule.params) - 1 else "")
+                )
             out.start(rule.pos.line, 0)
             head = ") -->"
         body = rule.body
@@ -241,12 +268,22 @@ class Formatter:
             return
         alts = body.choices if isinstance(body, n.Stochastic) else body.cases
         heads = [self.alt_head(a) for a in alts]
-        inline = head + " " + " | ".join(h + self.inline_steps(a.body.steps) for h, a in zip(heads, alts))
+        inline = (
+            head
+            + " "
+            + " | ".join(h + self.inline_steps(a.body.steps) for h, a in zip(heads, alts))
+        )
         # Branches have no closing bracket, so a comment after the last one also keeps them
         # one per line once they already start below the head (that is how fmt wrote them).
-        trailing_below = body.pos.line > rule.pos.line and self.has_comment_on_line(body.pos.end_line)
-        if all(self.can_inline(a.body) for a in alts) and not self.has_comment_inside(body.pos) \
-                and not trailing_below and len(inline) <= self.width:
+        trailing_below = body.pos.line > rule.pos.line and self.has_comment_on_line(
+            body.pos.end_line
+        )
+        if (
+            all(self.can_inline(a.body) for a in alts)
+            and not self.has_comment_inside(body.pos)
+            and not trailing_below
+            and len(inline) <= self.width
+        ):
             out.write(inline)
             return
         out.write(head)
@@ -278,7 +315,10 @@ class Formatter:
             if isinstance(step, n.Nil):
                 out.write("NIL")
             elif isinstance(step, n.Successor):
-                out.write(step.name + (f"({', '.join(format_arg(a) for a in step.args)})" if step.args else ""))
+                out.write(
+                    step.name
+                    + (f"({', '.join(format_arg(a) for a in step.args)})" if step.args else "")
+                )
             elif isinstance(step, n.Push):
                 out.write("[ " if step.steps else "[")
                 self.steps(step.steps, out, force_inline)
@@ -287,12 +327,16 @@ class Formatter:
                 out.write(f"{step.name}({', '.join(format_arg(a) for a in step.args)})")
                 if step.block is not None:
                     out.write(" ")
-                    self.block(step.block.entries, step.block.repeat, step.block.pos, out, force_inline)
+                    self.block(
+                        step.block.entries, step.block.repeat, step.block.pos, out, force_inline
+                    )
             else:
                 raise TypeError(f"not a step: {step!r}")
 
     def inline_block(self, entries, star: bool) -> str:
-        return "{ " + " | ".join(self.inline_entry(e) for e in entries) + " }" + ("*" if star else "")
+        return (
+            "{ " + " | ".join(self.inline_entry(e) for e in entries) + " }" + ("*" if star else "")
+        )
 
     def inline_entry(self, entry) -> str:
         if isinstance(entry, n.Group):
@@ -306,8 +350,9 @@ class Formatter:
     def block(self, entries, star: bool, pos: n.Pos, out: _Writer, force_inline: bool) -> None:
         inline = self.inline_block(entries, star)
         fits = out.column() + len(inline) <= self.width
-        if force_inline or (fits and not self.has_comment_inside(pos)
-                            and all(self.can_inline(e) for e in entries)):
+        if force_inline or (
+            fits and not self.has_comment_inside(pos) and all(self.can_inline(e) for e in entries)
+        ):
             out.write(inline)
             return
         indent = out.indent
@@ -334,7 +379,9 @@ class Formatter:
                 i = bisect.bisect_right(anchors, c.line)
                 if i < len(lines):
                     target = lines[i]
-                    leading.setdefault(i, []).append(Line(c.text, c.line, target.indent, target.top))
+                    leading.setdefault(i, []).append(
+                        Line(c.text, c.line, target.indent, target.top)
+                    )
                 else:
                     tail.append(Line(c.text, c.line, 0, True))
             else:
@@ -347,7 +394,9 @@ class Formatter:
         for i, line in enumerate(lines):
             placed += leading.get(i, [])
             if i in trailing:
-                line = Line(line.text + "  " + "  ".join(trailing[i]), line.anchor, line.indent, line.top)
+                line = Line(
+                    line.text + "  " + "  ".join(trailing[i]), line.anchor, line.indent, line.top
+                )
             placed.append(line)
         return placed + tail
 
@@ -386,8 +435,15 @@ def format_module(module: n.Module, width: int = WIDTH) -> str:
     try:
         return Formatter(module, width).format()
     except RecursionError:
-        raise BgrError(Diagnostic(module.path, 0, 0, "the grammar nests expressions or blocks too deeply "
-                                  "to format", "split deep nesting into separate rules")) from None
+        raise BgrError(
+            Diagnostic(
+                module.path,
+                0,
+                0,
+                "the grammar nests expressions or blocks too deeply to format",
+                "split deep nesting into separate rules",
+            )
+        ) from None
 
 
 def format_source(text: str, path: str = "<text>") -> str:

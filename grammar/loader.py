@@ -42,7 +42,9 @@ def read_source(path: str | os.PathLike) -> str:
     except IsADirectoryError:
         raise BgrError(Diagnostic(shown, 0, 0, "is a folder, not a .bgr file")) from None
     except OSError as e:
-        raise BgrError(Diagnostic(shown, 0, 0, f"cannot read the file: {e.strerror or e}")) from None
+        raise BgrError(
+            Diagnostic(shown, 0, 0, f"cannot read the file: {e.strerror or e}")
+        ) from None
     return decode(data, shown)
 
 
@@ -52,8 +54,15 @@ def decode(data: bytes, path: str) -> str:
     except UnicodeDecodeError as e:
         line = data.count(b"\n", 0, e.start) + 1
         column = e.start - (data.rfind(b"\n", 0, e.start) + 1) + 1
-        raise BgrSyntaxError(Diagnostic(path, line, column, f"the file is not UTF-8 text (byte 0x{data[e.start]:02x})",
-                                        "save it as UTF-8")) from None
+        raise BgrSyntaxError(
+            Diagnostic(
+                path,
+                line,
+                column,
+                f"the file is not UTF-8 text (byte 0x{data[e.start]:02x})",
+                "save it as UTF-8",
+            )
+        ) from None
     return text[1:] if text.startswith("\ufeff") else text
 
 
@@ -65,7 +74,9 @@ class Loader:
         self.failed: set[str] = set()
         self.diagnostics: list[Diagnostic] = []
 
-    def load_text(self, text: str, path: str, key: str | None, stack: tuple[str, ...]) -> Grammar | None:
+    def load_text(
+        self, text: str, path: str, key: str | None, stack: tuple[str, ...]
+    ) -> Grammar | None:
         try:
             module = parse(text, path)
         except BgrError as e:
@@ -83,22 +94,36 @@ class Loader:
         self.diagnostics += Checker(grammar, broken).check()
         return grammar
 
-    def load_import(self, item: n.Import, folder: Path, module: n.Module, stack: tuple[str, ...]) -> Grammar | None:
+    def load_import(
+        self, item: n.Import, folder: Path, module: n.Module, stack: tuple[str, ...]
+    ) -> Grammar | None:
         def fail(message: str, hint: str | None = None) -> None:
-            self.diagnostics.append(Diagnostic(module.path, item.pos.line, item.pos.column, message, hint,
-                                               source_line(module.source, item.pos.line)))
+            self.diagnostics.append(
+                Diagnostic(
+                    module.path,
+                    item.pos.line,
+                    item.pos.column,
+                    message,
+                    hint,
+                    source_line(module.source, item.pos.line),
+                )
+            )
 
         if item.module is not None:
             parts = item.module.split(".")
             if parts[0] != "stdlib" or len(parts) != 2:
-                fail(f"cannot import '{item.module}' by name: only stdlib.NAME modules are",
-                     f'import other files by path: import "{"/".join(parts)}.bgr" as {item.alias}')
+                fail(
+                    f"cannot import '{item.module}' by name: only stdlib.NAME modules are",
+                    f'import other files by path: import "{"/".join(parts)}.bgr" as {item.alias}',
+                )
                 return None
             target = _stdlib_dir() / f"{parts[1]}.bgr"
             if not target.is_file():
                 hint = suggest(parts[1], stdlib_modules())
-                fail(f"there is no stdlib module '{parts[1]}'",
-                     hint or "known: " + ", ".join(stdlib_modules()))
+                fail(
+                    f"there is no stdlib module '{parts[1]}'",
+                    hint or "known: " + ", ".join(stdlib_modules()),
+                )
                 return None
             shown = f"stdlib/{parts[1]}.bgr"
         else:
@@ -109,8 +134,14 @@ class Loader:
                 return None
         key = str(target.resolve())
         if key in stack:
-            chain = " -> ".join(Path(k).name for k in stack[stack.index(key):]) + f" -> {Path(key).name}"
-            fail(f"import cycle: {chain}", "a module cannot import itself, directly or through others")
+            chain = (
+                " -> ".join(Path(k).name for k in stack[stack.index(key) :])
+                + f" -> {Path(key).name}"
+            )
+            fail(
+                f"import cycle: {chain}",
+                "a module cannot import itself, directly or through others",
+            )
             return None
         if key in self.done:
             return self.done[key]
@@ -147,19 +178,29 @@ def load(source: str | bytes | os.PathLike, path: str | None = None) -> Grammar:
     elif isinstance(source, str):
         text = source
     else:
-        raise TypeError(f"bgr.load takes a path or the text of a grammar, not {type(source).__name__}")
+        raise TypeError(
+            f"bgr.load takes a path or the text of a grammar, not {type(source).__name__}"
+        )
     if path is not None and key is None and Path(path).suffix == ".bgr":
         key = str(Path(path).resolve())
     loader = Loader()
     try:
         grammar = loader.load_text(text, path or "<text>", key, (key,) if key else ())
     except RecursionError:
-        raise BgrSyntaxError(Diagnostic(path or "<text>", 0, 0,
-                                        "the grammar nests expressions or blocks too deeply to process",
-                                        "split deep nesting into separate rules")) from None
+        raise BgrSyntaxError(
+            Diagnostic(
+                path or "<text>",
+                0,
+                0,
+                "the grammar nests expressions or blocks too deeply to process",
+                "split deep nesting into separate rules",
+            )
+        ) from None
     if loader.diagnostics:
         unique = {(d.path, d.line, d.column, d.message): d for d in loader.diagnostics}
-        ordered = sorted(unique.values(), key=lambda d: (d.path != (path or "<text>"), d.path, d.line, d.column))
+        ordered = sorted(
+            unique.values(), key=lambda d: (d.path != (path or "<text>"), d.path, d.line, d.column)
+        )
         raise (BgrSyntaxError if grammar is None else BgrCheckError)(ordered)
     assert grammar is not None
     return grammar

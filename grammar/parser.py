@@ -71,16 +71,23 @@ def _keywords_last(args: list) -> None:
         if isinstance(arg, n.Keyword):
             seen_keyword = True
         elif seen_keyword:
-            raise _Problem(arg.pos, "a positional argument follows a keyword argument",
-                           "put the positional arguments first")
+            raise _Problem(
+                arg.pos,
+                "a positional argument follows a keyword argument",
+                "put the positional arguments first",
+            )
 
 
 def _no_keywords(args: list, what: str) -> None:
     """Keyword arguments name rule parameters; operations and functions take positions only."""
     for arg in args:
         if isinstance(arg, n.Keyword):
-            raise _Problem(arg.pos, f"{what} takes no keyword arguments",
-                           f"write the value alone, without '{arg.name} ='", len(arg.name))
+            raise _Problem(
+                arg.pos,
+                f"{what} takes no keyword arguments",
+                f"write the value alone, without '{arg.name} ='",
+                len(arg.name),
+            )
 
 
 class _Problem(Exception):
@@ -101,8 +108,12 @@ def _unescape(tok: Token) -> str:
             nxt = body[i + 1]
             if nxt not in escapes:
                 pos = n.Pos(tok.line, tok.column + i + 1, tok.line, tok.column + i + 2)
-                raise _Problem(pos, f"unknown escape '\\{nxt}' in a string",
-                               'strings know \\" \\\\ \\n and \\t; write \\\\ for a backslash', 2)
+                raise _Problem(
+                    pos,
+                    f"unknown escape '\\{nxt}' in a string",
+                    'strings know \\" \\\\ \\n and \\t; write \\\\ for a backslash',
+                    2,
+                )
             out.append(escapes[nxt])
             i += 2
         else:
@@ -135,8 +146,13 @@ class _TreeBuilder(Transformer):
 
     def func_decl(self, c):
         params = c[1] or []
-        return n.Func(str(c[0]), [str(p) for p in params], c[2], pos=_span(c),
-                      param_pos=[_tok_pos(p) for p in params])
+        return n.Func(
+            str(c[0]),
+            [str(p) for p in params],
+            c[2],
+            pos=_span(c),
+            param_pos=[_tok_pos(p) for p in params],
+        )
 
     def asset_decl(self, c):
         return n.Asset(str(c[0]), _unescape(c[1]), pos=_span(c))
@@ -151,18 +167,33 @@ class _TreeBuilder(Transformer):
         return list(c)
 
     def dotted(self, c):
-        return Token("NAME", ".".join(c), line=c[0].line, column=c[0].column,
-                     end_line=c[-1].end_line, end_column=c[-1].end_column)
+        return Token(
+            "NAME",
+            ".".join(c),
+            line=c[0].line,
+            column=c[0].column,
+            end_line=c[-1].end_line,
+            end_column=c[-1].end_column,
+        )
 
     # ---- rules ----------------------------------------------------------------------------
     def rule(self, c):
         name_tok, params, _arrow, body = c
         if str(name_tok) in KEYWORDS:
-            raise _Problem(_tok_pos(name_tok), f"'{name_tok}' is a keyword and cannot name a rule",
-                           "choose another name, e.g. a capitalised one", len(name_tok))
-        return n.Rule(str(name_tok), [str(p) for p, _ in params], body, pos=_span(c),
-                      param_pos=[_tok_pos(p) for p, _ in params],
-                      defaults=[d for _, d in params] if any(d is not None for _, d in params) else [])
+            raise _Problem(
+                _tok_pos(name_tok),
+                f"'{name_tok}' is a keyword and cannot name a rule",
+                "choose another name, e.g. a capitalised one",
+                len(name_tok),
+            )
+        return n.Rule(
+            str(name_tok),
+            [str(p) for p, _ in params],
+            body,
+            pos=_span(c),
+            param_pos=[_tok_pos(p) for p, _ in params],
+            defaults=[d for _, d in params] if any(d is not None for _, d in params) else [],
+        )
 
     def rule_params(self, c):
         return c[0] if c and c[0] else []
@@ -179,17 +210,28 @@ class _TreeBuilder(Transformer):
             if kind == "else" and i != len(alts) - 1:
                 raise _Problem(pos, "'else' must be the last alternative", length=4)
         if set(kinds) == {"else"}:
-            raise _Problem(alts[0][3], "a body cannot be only an 'else' branch",
-                           "write the sequence without 'else:'", 4)
+            raise _Problem(
+                alts[0][3],
+                "a body cannot be only an 'else' branch",
+                "write the sequence without 'else:'",
+                4,
+            )
         if "choice" in kinds and "case" in kinds:
             second = alts[kinds.index("case" if kinds[0] == "choice" else "choice")]
-            raise _Problem(second[3], "a body mixes percentages and 'case' conditions",
-                           "use either '60%: A | else: B' or 'case cond: A | else: B'")
+            raise _Problem(
+                second[3],
+                "a body mixes percentages and 'case' conditions",
+                "use either '60%: A | else: B' or 'case cond: A | else: B'",
+            )
         if "choice" in kinds:
-            return n.Stochastic([n.Choice(test, body, pos=pos) for _, test, body, pos in alts],
-                                pos=_span(alts[0][3], alts[-1][3]))
-        return n.Conditional([n.Case(test, body, pos=pos) for _, test, body, pos in alts],
-                             pos=_span(alts[0][3], alts[-1][3]))
+            return n.Stochastic(
+                [n.Choice(test, body, pos=pos) for _, test, body, pos in alts],
+                pos=_span(alts[0][3], alts[-1][3]),
+            )
+        return n.Conditional(
+            [n.Case(test, body, pos=pos) for _, test, body, pos in alts],
+            pos=_span(alts[0][3], alts[-1][3]),
+        )
 
     def choice(self, c):
         return ("choice", c[0], c[1], _span(c))
@@ -220,8 +262,12 @@ class _TreeBuilder(Transformer):
             return n.Operation(name, args, block, pos=_span(c))
         if block is not None:
             hint = suggest(name, [op for op, spec in OPERATIONS.items() if spec.block])
-            raise _Problem(_tok_pos(c[0]), f"unknown operation '{name}' with a {{ }} block",
-                           hint or "only split, comp and offset take a { } block", len(name))
+            raise _Problem(
+                _tok_pos(c[0]),
+                f"unknown operation '{name}' with a {{ }} block",
+                hint or "only split, comp and offset take a { } block",
+                len(name),
+            )
         # keyword arguments make it a rule application (operations take none): a parameter named
         # like an operation (`roof(pitch = 20)` with a parameter `roof`); the checker decides
         return n.Successor(name, args, pos=_span(c))
@@ -301,10 +347,22 @@ class _TreeBuilder(Transformer):
 
 
 # Binding powers: (left, right).  Left-associative operators bind tighter on the right.
-_INFIX = {"or": (1, 2), "and": (3, 4),
-          "==": (7, 8), "!=": (7, 8), "<": (7, 8), "<=": (7, 8), ">": (7, 8), ">=": (7, 8),
-          "+": (9, 10), "-": (9, 10), "*": (11, 12), "/": (11, 12), "%": (11, 12),
-          "**": (15, 15)}
+_INFIX = {
+    "or": (1, 2),
+    "and": (3, 4),
+    "==": (7, 8),
+    "!=": (7, 8),
+    "<": (7, 8),
+    "<=": (7, 8),
+    ">": (7, 8),
+    ">=": (7, 8),
+    "+": (9, 10),
+    "-": (9, 10),
+    "*": (11, 12),
+    "/": (11, 12),
+    "%": (11, 12),
+    "**": (15, 15),
+}
 _PREFIX = {"not": 5, "-": 13, "+": 13}  # right binding power of each prefix operator
 _COMPARISONS = {"==", "!=", "<", "<=", ">", ">="}
 
@@ -334,10 +392,18 @@ class _Pratt:
                 break
             self.i += 1
             right = self.parse(rbp)
-            if str(op) in _COMPARISONS and self.i < len(self.stream) and str(self.stream[self.i]) in _COMPARISONS:
+            if (
+                str(op) in _COMPARISONS
+                and self.i < len(self.stream)
+                and str(self.stream[self.i]) in _COMPARISONS
+            ):
                 nxt = self.stream[self.i]
-                raise _Problem(_tok_pos(nxt), f"comparisons cannot be chained: '{op}' then '{nxt}'",
-                               "write 'a < b and b < c'", len(nxt))
+                raise _Problem(
+                    _tok_pos(nxt),
+                    f"comparisons cannot be chained: '{op}' then '{nxt}'",
+                    "write 'a < b and b < c'",
+                    len(nxt),
+                )
             left = n.Binary(str(op), left, right, pos=_span(left, right))
         return left
 
@@ -374,6 +440,8 @@ def _no_gc():
     finally:
         if enabled:
             gc.enable()
+
+
 _comments = _Comments()
 _parser: Lark | None = None
 
@@ -381,9 +449,15 @@ _parser: Lark | None = None
 def _lark() -> Lark:
     global _parser
     if _parser is None:
-        _parser = Lark(GRAMMAR_FILE.read_text(encoding="utf-8"), parser="lalr", lexer="contextual",
-                       propagate_positions=True, maybe_placeholders=True,
-                       transformer=_TreeBuilder(), lexer_callbacks={"COMMENT": _comments})
+        _parser = Lark(
+            GRAMMAR_FILE.read_text(encoding="utf-8"),
+            parser="lalr",
+            lexer="contextual",
+            propagate_positions=True,
+            maybe_placeholders=True,
+            transformer=_TreeBuilder(),
+            lexer_callbacks={"COMMENT": _comments},
+        )
     return _parser
 
 
@@ -392,18 +466,42 @@ def parse(text: str, path: str = "<text>") -> n.Module:
     if "\x00" in text:
         line = text.count("\n", 0, text.index("\x00")) + 1
         col = text.index("\x00") - (text.rfind("\n", 0, text.index("\x00")) + 1) + 1
-        raise BgrSyntaxError(Diagnostic(path, line, col, "the file contains a NUL character",
-                                        "is this a binary file?", source_line(text, line)))
+        raise BgrSyntaxError(
+            Diagnostic(
+                path,
+                line,
+                col,
+                "the file contains a NUL character",
+                "is this a binary file?",
+                source_line(text, line),
+            )
+        )
     with _lock, _no_gc():
         _comments.tokens = []
         try:
             items = _lark().parse(text)
         except RecursionError:
-            raise BgrSyntaxError(Diagnostic(path, 0, 0, "the file nests expressions or blocks too deeply",
-                                            "split deep nesting into separate rules")) from None
+            raise BgrSyntaxError(
+                Diagnostic(
+                    path,
+                    0,
+                    0,
+                    "the file nests expressions or blocks too deeply",
+                    "split deep nesting into separate rules",
+                )
+            ) from None
         except _Problem as p:
-            raise BgrSyntaxError(Diagnostic(path, p.pos.line, p.pos.column, p.message, p.hint,
-                                            source_line(text, p.pos.line), p.length)) from None
+            raise BgrSyntaxError(
+                Diagnostic(
+                    path,
+                    p.pos.line,
+                    p.pos.column,
+                    p.message,
+                    p.hint,
+                    source_line(text, p.pos.line),
+                    p.length,
+                )
+            ) from None
         except UnexpectedInput as e:
             raise _translate(e, text, path) from None
         tokens = _comments.tokens
@@ -419,15 +517,41 @@ def parse(text: str, path: str = "<text>") -> n.Module:
 # ---- error translation --------------------------------------------------------------------------
 
 _TERMINAL_WORDS = {
-    "NAME": "a name", "RULE_NAME": "a rule ('Name --> ...')", "NUMBER": "a number",
-    "STRING": 'a string ("...")', "ARROW": "'-->'", "STAR": "'*'", "COMPARE": "a comparison",
-    "BINOP": "an operator", "PREFIX": "'-'", "AND": "'and'", "OR": "'or'", "NOT": "'not'",
-    "CASE": "'case'", "ELSE": "'else'", "NIL": "NIL", "TRUE": "'true'", "FALSE": "'false'",
-    "RBRACE": "'}'", "LSQB": "'['", "RSQB": "']'", "$END": "the end of the file",
+    "NAME": "a name",
+    "RULE_NAME": "a rule ('Name --> ...')",
+    "NUMBER": "a number",
+    "STRING": 'a string ("...")',
+    "ARROW": "'-->'",
+    "STAR": "'*'",
+    "COMPARE": "a comparison",
+    "BINOP": "an operator",
+    "PREFIX": "'-'",
+    "AND": "'and'",
+    "OR": "'or'",
+    "NOT": "'not'",
+    "CASE": "'case'",
+    "ELSE": "'else'",
+    "NIL": "NIL",
+    "TRUE": "'true'",
+    "FALSE": "'false'",
+    "RBRACE": "'}'",
+    "LSQB": "'['",
+    "RSQB": "']'",
+    "$END": "the end of the file",
 }
 _EXPRESSION_START = {"NUMBER", "STRING", "NAME", "LPAR", "PREFIX", "TRUE", "FALSE", "NOT"}
 _STEP_START = {"NAME", "LSQB", "NIL"}
-_DECLARATIONS = {"VERSION", "IMPORT", "ATTR", "CONST", "FUNC", "ASSET", "TERMINAL", "START", "RULE_NAME"}
+_DECLARATIONS = {
+    "VERSION",
+    "IMPORT",
+    "ATTR",
+    "CONST",
+    "FUNC",
+    "ASSET",
+    "TERMINAL",
+    "START",
+    "RULE_NAME",
+}
 
 
 def _describe_expected(expected: set[str]) -> list[str]:
@@ -457,7 +581,7 @@ def _describe_expected(expected: set[str]) -> list[str]:
 
 def _describe_token(tok: Token) -> str:
     if tok == "'":
-        return "\"'\""
+        return '"\'"'
     if tok.type == "$END":
         return "end of file"
     if tok.type in ("NAME", "RULE_NAME"):
@@ -496,12 +620,17 @@ def _translate(e: UnexpectedInput, text: str, path: str) -> BgrSyntaxError:
         if char == '"':
             message, hint = "unterminated string", 'close the string with " on the same line'
         elif char == "'" or char == "~":
-            message, hint = f"unexpected '{char}'", "relative ('0.5) and floating (~2) sizes go in split blocks"
+            message, hint = (
+                f"unexpected '{char}'",
+                "relative ('0.5) and floating (~2) sizes go in split blocks",
+            )
         else:
             message, hint = f"unexpected character {char!r}", None
-            if char == "-" and text[e.pos_in_stream:e.pos_in_stream + 2] == "->":
+            if char == "-" and text[e.pos_in_stream : e.pos_in_stream + 2] == "->":
                 hint = "a rule arrow is '-->'"
-        return BgrSyntaxError(Diagnostic(path, line, column, message, hint, source_line(text, line)))
+        return BgrSyntaxError(
+            Diagnostic(path, line, column, message, hint, source_line(text, line))
+        )
     tok = getattr(e, "token", None)
     expected = set(getattr(e, "accepts", None) or getattr(e, "expected", None) or ())
     special = _deep_default(text, path)
@@ -518,10 +647,15 @@ def _translate(e: UnexpectedInput, text: str, path: str) -> BgrSyntaxError:
     words = _describe_expected(expected)
     message = f"unexpected {_describe_token(tok) if tok is not None else 'input'}"
     if words:
-        message += "; expected " + (words[0] if len(words) == 1 else ", ".join(words[:-1]) + " or " + words[-1])
+        message += "; expected " + (
+            words[0] if len(words) == 1 else ", ".join(words[:-1]) + " or " + words[-1]
+        )
     length = len(tok) if tok is not None and tok.type != "$END" and "\n" not in tok else 1
-    return BgrSyntaxError(Diagnostic(path, line, column, message, _hint(tok, expected),
-                                     source_line(text, line), length))
+    return BgrSyntaxError(
+        Diagnostic(
+            path, line, column, message, _hint(tok, expected), source_line(text, line), length
+        )
+    )
 
 
 def _line_col(text: str, index: int) -> tuple[int, int]:
@@ -534,7 +668,7 @@ def _deep_default(text: str, path: str) -> BgrSyntaxError | None:
     would otherwise land somewhere puzzling."""
     at = text.find("-->")
     while at != -1:
-        if "#" in text[text.rfind("\n", 0, at) + 1:at]:  # an arrow in a comment
+        if "#" in text[text.rfind("\n", 0, at) + 1 : at]:  # an arrow in a comment
             at = text.find("-->", at + 3)
             continue
         i = at - 1
@@ -558,10 +692,17 @@ def _deep_default(text: str, path: str) -> BgrSyntaxError | None:
                 j -= 1
             if depth == 0 and deepest > 2 and j + 1 < i:
                 line, col = _line_col(text, j + 1)
-                return BgrSyntaxError(Diagnostic(
-                    path, line, col, "the defaults of this rule nest parentheses more than one level deep",
-                    "move the expression into a func (func f(x) = ...) and call that in the default",
-                    source_line(text, line), i - j - 1))
+                return BgrSyntaxError(
+                    Diagnostic(
+                        path,
+                        line,
+                        col,
+                        "the defaults of this rule nest parentheses more than one level deep",
+                        "move the expression into a func (func f(x) = ...) and call that in the default",
+                        source_line(text, line),
+                        i - j - 1,
+                    )
+                )
         at = text.find("-->", at + 3)
     return None
 
@@ -576,8 +717,17 @@ def _arrow_mistake(tok: Token, text: str, path: str) -> BgrSyntaxError | None:
     for at in (start, after):
         if text.startswith("->", at) and not text.startswith("-->", at - 1):
             line, col = _line_col(text, at)
-            return BgrSyntaxError(Diagnostic(path, line, col, "'->' is not the rule arrow", "write '-->'",
-                                             source_line(text, line), 2))
+            return BgrSyntaxError(
+                Diagnostic(
+                    path,
+                    line,
+                    col,
+                    "'->' is not the rule arrow",
+                    "write '-->'",
+                    source_line(text, line),
+                    2,
+                )
+            )
     if not text.startswith("-->", start):
         return None
     # `A -->` then `B --> ...`: walk back over B (and its parameters) to the arrow before it
@@ -595,10 +745,25 @@ def _arrow_mistake(tok: Token, text: str, path: str) -> BgrSyntaxError | None:
         k -= 1
     if name and text.endswith("-->", 0, k):
         line, col = _line_col(text, k)
-        return BgrSyntaxError(Diagnostic(
-            path, line, col, f"empty rule body (the next line starts the rule '{name}')",
-            "a body needs at least one step: write NIL to delete the shape", source_line(text, line)))
+        return BgrSyntaxError(
+            Diagnostic(
+                path,
+                line,
+                col,
+                f"empty rule body (the next line starts the rule '{name}')",
+                "a body needs at least one step: write NIL to delete the shape",
+                source_line(text, line),
+            )
+        )
     line, col = _line_col(text, start)
-    return BgrSyntaxError(Diagnostic(path, line, col, "unexpected '-->'",
-                                     "a rule is written 'Name --> body', one arrow per rule",
-                                     source_line(text, line), 3))
+    return BgrSyntaxError(
+        Diagnostic(
+            path,
+            line,
+            col,
+            "unexpected '-->'",
+            "a rule is written 'Name --> body', one arrow per rule",
+            source_line(text, line),
+            3,
+        )
+    )

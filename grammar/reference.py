@@ -7,8 +7,15 @@ A test keeps docs/operations.md equal to this output.
 
 from __future__ import annotations
 
-from .registry import (BUILTIN_NAMES, BUILTINS, COMP_SELECTORS, FOOTPRINT_KINDS, OPERATIONS, PRIMITIVES,
-                       ROOF_KINDS)
+from .registry import (
+    BUILTIN_NAMES,
+    BUILTINS,
+    COMP_SELECTORS,
+    FOOTPRINT_KINDS,
+    OPERATIONS,
+    PRIMITIVES,
+    ROOF_KINDS,
+)
 
 
 def _cell(text: str) -> str:
@@ -18,11 +25,20 @@ def _cell(text: str) -> str:
 
 def reference_markdown() -> str:
     """The operation and function reference, generated from this registry (docs/operations.md)."""
-    out = ["# Operations and built-in functions", "",
-           "Generated from `grammar/registry.py` by `python -m bgr.grammar.reference`; do not edit.", ""]
+    out = [
+        "# Operations and built-in functions",
+        "",
+        "Generated from `grammar/registry.py` by `python -m bgr.grammar.reference`; do not edit.",
+        "",
+    ]
     families = ["transforms", "splits", "components", "roofs", "inserts", "appearance"]
     for family in families:
-        out += [f"## {family.capitalize()}", "", "| operation | meaning | example |", "|---|---|---|"]
+        out += [
+            f"## {family.capitalize()}",
+            "",
+            "| operation | meaning | example |",
+            "|---|---|---|",
+        ]
         for op in OPERATIONS.values():
             if op.family == family:
                 out.append(f"| `{_cell(op.usage())}` | {_cell(op.doc)} | `{_cell(op.example)}` |")
@@ -33,14 +49,20 @@ def reference_markdown() -> str:
     out += ["", "## Built-in names", "", "| name | meaning |", "|---|---|"]
     for name, doc in BUILTIN_NAMES.items():
         out.append(f"| `{name}` | {doc} |")
-    out += ["", "Symbols: roof kinds " + ", ".join(f"`{k}`" for k in ROOF_KINDS)
-            + "; footprints " + ", ".join(f"`{k}`" for k in FOOTPRINT_KINDS)
-            + "; primitives " + ", ".join(f"`{p}`" for p in PRIMITIVES)
-            + "; component selectors " + ", ".join(f"`{s}`" for s in COMP_SELECTORS)
-            + ", `face(i)`; offset selectors `inside`, `border`.", ""]
+    out += [
+        "",
+        "Symbols: roof kinds "
+        + ", ".join(f"`{k}`" for k in ROOF_KINDS)
+        + "; footprints "
+        + ", ".join(f"`{k}`" for k in FOOTPRINT_KINDS)
+        + "; primitives "
+        + ", ".join(f"`{p}`" for p in PRIMITIVES)
+        + "; component selectors "
+        + ", ".join(f"`{s}`" for s in COMP_SELECTORS)
+        + ", `face(i)`; offset selectors `inside`, `border`.",
+        "",
+    ]
     return "\n".join(out)
-
-
 
 
 if __name__ == "__main__":

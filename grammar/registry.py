@@ -59,7 +59,9 @@ class Op:
         return out
 
     def usage(self) -> str:
-        return " or ".join(f"{self.name}({', '.join(p.name for p in sig)})" for sig in self.signatures)
+        return " or ".join(
+            f"{self.name}({', '.join(p.name for p in sig)})" for sig in self.signatures
+        )
 
 
 def _sig(*params: Param) -> tuple[tuple[Param, ...], ...]:
@@ -72,70 +74,139 @@ OPERATIONS: dict[str, Op] = {
     op.name: op
     for op in [
         # -- transforms --------------------------------------------------------------------
-        Op("t", "transforms", _sig(Param("x", SIZE), Param("y", SIZE), Param("z", SIZE)),
-           "Translate the scope along its own axes; `'f` is a fraction of the scope size.",
-           "t(0, 0, '0.5)"),
-        Op("r", "transforms", _sig(Param("x", NUMBER), Param("y", NUMBER), Param("z", NUMBER)),
-           "Rotate about the scope origin, in degrees, x then y then z, in scope coordinates.",
-           "r(0, 90, 0)"),
-        Op("s", "transforms", _sig(Param("x", SIZE), Param("y", SIZE), Param("z", SIZE)),
-           "Set the scope size; the geometry is scaled with it. `'f` is relative to the current size.",
-           "s('0.5, '1, 2)"),
-        Op("center", "transforms", _sig(Param("axes", AXES)),
-           "Centre the scope along the given axes on the previous scope (the one saved by the last "
-           "`[`, or the shape the rule received).",
-           "center(xz)"),
-        Op("matrix", "transforms", (_MATRIX,),
-           "Apply a 3x4 affine transform, given row by row, to the scope.",
-           "matrix(1, 0, 0, 2, 0, 1, 0, 0, 0, 0, 1, 0)"),
-        # -- splits ------------------------------------------------------------------------
-        Op("split", "splits", _sig(Param("axis", AXIS)),
-           "Cut the scope along an axis into pieces of absolute (`3`), relative (`'0.25`) and "
-           "floating (`~3`) sizes; `{ ... }*` repeats.",
-           "split(x) { 1: Edge | { ~2: Window }* | 1: Edge }", block="split"),
-        # -- components --------------------------------------------------------------------
-        Op("comp", "components", _sig(Param("kind", COMP_KIND)),
-           "Split a 3D shape into its faces (`f`), each a 2D shape with x along its bottom edge, "
-           "y up and z out.",
-           "comp(f) { top: Roof | side: Facade }", block="comp"),
-        Op("offset", "components", _sig(Param("distance", NUMBER)),
-           "Inset a 2D face by a distance (a negative one grows it) into an inside and a border.",
-           "offset(0.2) { inside: Glass | border: Frame }", block="offset"),
-        Op("footprint", "components",
-           _sig(Param("kind", FOOTPRINT_KIND), Param("a", NUMBER, 0.4), Param("b", NUMBER, -1.0)),
-           "Replace a 2D shape's outline by a building footprint filling its scope: `rect`, `L`, `U`, "
-           "`T`, `cross` (wing widths `a`, `b` as fractions of the scope; `b` defaults to `a`), "
-           "`circle` (`a` sides, at least 3 when given).",
-           "footprint(L, 0.4, 0.5)"),
-        Op("extrude", "components", _sig(Param("height", NUMBER)),
-           "Turn a 2D shape into a prism of the given height along its normal.",
-           "extrude(12)"),
-        Op("taper", "components", _sig(Param("height", NUMBER), Param("ratio", NUMBER)),
-           "Extrude to a height while scaling the top by a ratio.",
-           "taper(30, 0.6)"),
-        # -- roofs -------------------------------------------------------------------------
-        Op("roof", "roofs",
-           _sig(Param("kind", ROOF_KIND), Param("pitch", NUMBER, 30.0), Param("overhang", NUMBER, 0.0)),
-           "Build a roof of the given kind on a 2D footprint: pitch in degrees, overhang in metres.",
-           "roof(hip, 30, 0.5)"),
-        # -- inserts -----------------------------------------------------------------------
-        Op("i", "inserts", _sig(Param("geometry", GEOMETRY)),
-           "Insert a primitive (cube, cylinder, sphere, quad, wedge) or a declared asset, fitted to "
-           "the scope.",
-           "i(cube)"),
-        # -- appearance --------------------------------------------------------------------
-        Op("color", "appearance", (
-            (Param("color", COLOR),),
-            (Param("r", NUMBER), Param("g", NUMBER), Param("b", NUMBER)),
+        Op(
+            "t",
+            "transforms",
+            _sig(Param("x", SIZE), Param("y", SIZE), Param("z", SIZE)),
+            "Translate the scope along its own axes; `'f` is a fraction of the scope size.",
+            "t(0, 0, '0.5)",
         ),
-           "Set the colour of the shape and its descendants: a \"#rrggbb\" string or r, g, b in 0..1.",
-           'color("#c8b89a")'),
-        Op("material", "appearance", _sig(Param("name", STRING)),
-           "Set a named material; the name reaches the output file.",
-           'material("brick")'),
-        Op("label", "appearance", _sig(Param("name", STRING)),
-           "Set the semantic label written to outputs (default: the terminal rule's name).",
-           'label("Window")'),
+        Op(
+            "r",
+            "transforms",
+            _sig(Param("x", NUMBER), Param("y", NUMBER), Param("z", NUMBER)),
+            "Rotate about the scope origin, in degrees, x then y then z, in scope coordinates.",
+            "r(0, 90, 0)",
+        ),
+        Op(
+            "s",
+            "transforms",
+            _sig(Param("x", SIZE), Param("y", SIZE), Param("z", SIZE)),
+            "Set the scope size; the geometry is scaled with it. `'f` is relative to the current size.",
+            "s('0.5, '1, 2)",
+        ),
+        Op(
+            "center",
+            "transforms",
+            _sig(Param("axes", AXES)),
+            "Centre the scope along the given axes on the previous scope (the one saved by the last "
+            "`[`, or the shape the rule received).",
+            "center(xz)",
+        ),
+        Op(
+            "matrix",
+            "transforms",
+            (_MATRIX,),
+            "Apply a 3x4 affine transform, given row by row, to the scope.",
+            "matrix(1, 0, 0, 2, 0, 1, 0, 0, 0, 0, 1, 0)",
+        ),
+        # -- splits ------------------------------------------------------------------------
+        Op(
+            "split",
+            "splits",
+            _sig(Param("axis", AXIS)),
+            "Cut the scope along an axis into pieces of absolute (`3`), relative (`'0.25`) and "
+            "floating (`~3`) sizes; `{ ... }*` repeats.",
+            "split(x) { 1: Edge | { ~2: Window }* | 1: Edge }",
+            block="split",
+        ),
+        # -- components --------------------------------------------------------------------
+        Op(
+            "comp",
+            "components",
+            _sig(Param("kind", COMP_KIND)),
+            "Split a 3D shape into its faces (`f`), each a 2D shape with x along its bottom edge, "
+            "y up and z out.",
+            "comp(f) { top: Roof | side: Facade }",
+            block="comp",
+        ),
+        Op(
+            "offset",
+            "components",
+            _sig(Param("distance", NUMBER)),
+            "Inset a 2D face by a distance (a negative one grows it) into an inside and a border.",
+            "offset(0.2) { inside: Glass | border: Frame }",
+            block="offset",
+        ),
+        Op(
+            "footprint",
+            "components",
+            _sig(Param("kind", FOOTPRINT_KIND), Param("a", NUMBER, 0.4), Param("b", NUMBER, -1.0)),
+            "Replace a 2D shape's outline by a building footprint filling its scope: `rect`, `L`, `U`, "
+            "`T`, `cross` (wing widths `a`, `b` as fractions of the scope; `b` defaults to `a`), "
+            "`circle` (`a` sides, at least 3 when given).",
+            "footprint(L, 0.4, 0.5)",
+        ),
+        Op(
+            "extrude",
+            "components",
+            _sig(Param("height", NUMBER)),
+            "Turn a 2D shape into a prism of the given height along its normal.",
+            "extrude(12)",
+        ),
+        Op(
+            "taper",
+            "components",
+            _sig(Param("height", NUMBER), Param("ratio", NUMBER)),
+            "Extrude to a height while scaling the top by a ratio.",
+            "taper(30, 0.6)",
+        ),
+        # -- roofs -------------------------------------------------------------------------
+        Op(
+            "roof",
+            "roofs",
+            _sig(
+                Param("kind", ROOF_KIND),
+                Param("pitch", NUMBER, 30.0),
+                Param("overhang", NUMBER, 0.0),
+            ),
+            "Build a roof of the given kind on a 2D footprint: pitch in degrees, overhang in metres.",
+            "roof(hip, 30, 0.5)",
+        ),
+        # -- inserts -----------------------------------------------------------------------
+        Op(
+            "i",
+            "inserts",
+            _sig(Param("geometry", GEOMETRY)),
+            "Insert a primitive (cube, cylinder, sphere, quad, wedge) or a declared asset, fitted to "
+            "the scope.",
+            "i(cube)",
+        ),
+        # -- appearance --------------------------------------------------------------------
+        Op(
+            "color",
+            "appearance",
+            (
+                (Param("color", COLOR),),
+                (Param("r", NUMBER), Param("g", NUMBER), Param("b", NUMBER)),
+            ),
+            'Set the colour of the shape and its descendants: a "#rrggbb" string or r, g, b in 0..1.',
+            'color("#c8b89a")',
+        ),
+        Op(
+            "material",
+            "appearance",
+            _sig(Param("name", STRING)),
+            "Set a named material; the name reaches the output file.",
+            'material("brick")',
+        ),
+        Op(
+            "label",
+            "appearance",
+            _sig(Param("name", STRING)),
+            "Set the semantic label written to outputs (default: the terminal rule's name).",
+            'label("Window")',
+        ),
     ]
 }
 
@@ -152,12 +223,20 @@ class Builtin:
 BUILTINS: dict[str, Builtin] = {
     b.name: b
     for b in [
-        Builtin("rand", 0, 2, "rand(a, b)", "a uniform draw from the shape's stream: rand() in [0, 1), "
-                "rand(b) in [0, b), rand(a, b) in [a, b)."),
+        Builtin(
+            "rand",
+            0,
+            2,
+            "rand(a, b)",
+            "a uniform draw from the shape's stream: rand() in [0, 1), "
+            "rand(b) in [0, b), rand(a, b) in [a, b).",
+        ),
         Builtin("randint", 2, 2, "randint(a, b)", "a whole number from a to b inclusive."),
         Builtin("floor", 1, 1, "floor(x)", "round down."),
         Builtin("ceil", 1, 1, "ceil(x)", "round up."),
-        Builtin("round", 1, 1, "round(x)", "round to the nearest whole number (halves away from zero)."),
+        Builtin(
+            "round", 1, 1, "round(x)", "round to the nearest whole number (halves away from zero)."
+        ),
         Builtin("abs", 1, 1, "abs(x)", "absolute value."),
         Builtin("min", 2, None, "min(a, b, ...)", "the least of two or more numbers."),
         Builtin("max", 2, None, "max(a, b, ...)", "the greatest of two or more numbers."),
@@ -171,16 +250,38 @@ BUILTINS: dict[str, Builtin] = {
 
 # Names the interpreter provides while deriving a shape (LANGUAGE.md section 8).
 BUILTIN_NAMES: dict[str, str] = {
-    "scope.sx": "scope size along x", "scope.sy": "scope size along y", "scope.sz": "scope size along z",
-    "scope.x": "scope origin x in the parent frame", "scope.y": "scope origin y", "scope.z": "scope origin z",
+    "scope.sx": "scope size along x",
+    "scope.sy": "scope size along y",
+    "scope.sz": "scope size along z",
+    "scope.x": "scope origin x in the parent frame",
+    "scope.y": "scope origin y",
+    "scope.z": "scope origin z",
     "split.index": "0-based index of the piece in the enclosing split (global across repetitions)",
     "split.total": "number of pieces of the enclosing split",
     "comp.index": "0-based index of the face in the enclosing component split",
     "comp.total": "number of faces of the enclosing component split",
     "comp.left": "the corner at the face's left edge, seen from outside: the angle the wall turns there in degrees (90 at a box's corners, -90 at an inner corner, 0 where the wall runs on or for a top or bottom face)",
     "comp.right": "the corner at the face's right edge, as comp.left",
-    "depth": "derivation depth of the shape", "seed": "the global seed",
+    "depth": "derivation depth of the shape",
+    "seed": "the global seed",
 }
 
-KEYWORDS = ("version", "import", "as", "attr", "const", "func", "start", "asset", "terminal",
-            "case", "else", "NIL", "true", "false", "and", "or", "not")
+KEYWORDS = (
+    "version",
+    "import",
+    "as",
+    "attr",
+    "const",
+    "func",
+    "start",
+    "asset",
+    "terminal",
+    "case",
+    "else",
+    "NIL",
+    "true",
+    "false",
+    "and",
+    "or",
+    "not",
+)

@@ -63,26 +63,39 @@ def _cell(text: str) -> str:
 def stdlib_markdown(example: dict[str, str] | None = None) -> str:
     """docs/stdlib.md.  ``example`` names the rules of the composition example."""
     example = example or {"mass": "LHip", "upper": "Grid", "street": "Shopfront"}
-    out = ["# The standard library", "",
-           "Generated from the doc comments of `stdlib/*.bgr` by `python -m bgr.grammar.stdlib_reference`;",
-           "thumbnails by `python docs/make_gallery.py`. Do not edit.", "",
-           "The standard library is a set of `.bgr` modules bundled with bgr. A grammar imports them",
-           "with `import stdlib.NAME as alias` and applies their rules like its own. Every rule takes",
-           "parameters with defaults ([defaults and keyword arguments](language.md#defaults-keyword-arguments-and-rules-as-parameters)),",
-           "so `fac.Grid` and `fac.Grid(tile_w = 4, window = win.Arched)` both work, and the parts",
-           "of a mass or a façade (its façades, windows, doors, roof) are rules handed over as",
-           "parameters: plug in your own rule anywhere a stdlib part goes. The families follow",
-           "Nishida et al. 2018 (*Procedural modeling of a building from a single image*): 30 masses",
-           "(Figure 3), 16 façades (Figure 5) and 31 windows and entrances (Figure 6), plus roof",
-           "assemblies and a colour palette.", "",
-           "A building from the library in a few lines:", "", "```bgr", EXAMPLE.format(**example).rstrip(), "```", "",
-           "What each module's rules receive:", "",
-           "- **masses** receive the lot (a flat footprint); `facade` is applied to every side face,"
-           " `front` to the street face, `roof` to the top;",
-           "- **façades** receive a vertical face from `comp(f)` and split it into floors and tiles;",
-           "- **windows and entrances** receive the opening rectangle a façade leaves for them;",
-           "- **roof assemblies** receive the top face of a mass.", "",
-           "![contact sheet of the standard library](img/stdlib/contact_sheet.png)", ""]
+    out = [
+        "# The standard library",
+        "",
+        "Generated from the doc comments of `stdlib/*.bgr` by `python -m bgr.grammar.stdlib_reference`;",
+        "thumbnails by `python docs/make_gallery.py`. Do not edit.",
+        "",
+        "The standard library is a set of `.bgr` modules bundled with bgr. A grammar imports them",
+        "with `import stdlib.NAME as alias` and applies their rules like its own. Every rule takes",
+        "parameters with defaults ([defaults and keyword arguments](language.md#defaults-keyword-arguments-and-rules-as-parameters)),",
+        "so `fac.Grid` and `fac.Grid(tile_w = 4, window = win.Arched)` both work, and the parts",
+        "of a mass or a façade (its façades, windows, doors, roof) are rules handed over as",
+        "parameters: plug in your own rule anywhere a stdlib part goes. The families follow",
+        "Nishida et al. 2018 (*Procedural modeling of a building from a single image*): 30 masses",
+        "(Figure 3), 16 façades (Figure 5) and 31 windows and entrances (Figure 6), plus roof",
+        "assemblies and a colour palette.",
+        "",
+        "A building from the library in a few lines:",
+        "",
+        "```bgr",
+        EXAMPLE.format(**example).rstrip(),
+        "```",
+        "",
+        "What each module's rules receive:",
+        "",
+        "- **masses** receive the lot (a flat footprint); `facade` is applied to every side face,"
+        " `front` to the street face, `roof` to the top;",
+        "- **façades** receive a vertical face from `comp(f)` and split it into floors and tiles;",
+        "- **windows and entrances** receive the opening rectangle a façade leaves for them;",
+        "- **roof assemblies** receive the top face of a mass.",
+        "",
+        "![contact sheet of the standard library](img/stdlib/contact_sheet.png)",
+        "",
+    ]
     for name in MODULES:
         tree, rules = public_rules(name)
         out += [f"## {TITLES[name]}", ""]
@@ -98,7 +111,9 @@ def stdlib_markdown(example: dict[str, str] | None = None) -> str:
         out += ["| | rule |", "|---|---|"]
         for rule, doc in rules:
             summary = doc.summary if doc else ""
-            params = "".join(f"<br>`{p}`: {_cell(text)}" for p, text in (doc.params.items() if doc else []))
+            params = "".join(
+                f"<br>`{p}`: {_cell(text)}" for p, text in (doc.params.items() if doc else [])
+            )
             image = f"![{rule.name}]({thumbnail_path(name, rule.name)})"
             out.append(f"| {image} | `{_cell(_signature(rule))}`<br>{_cell(summary)}{params} |")
         out.append("")

@@ -41,10 +41,16 @@ class Result:
         write(self.terminals, Path(path), seed=self.seed, attrs=self.attrs, fmt=fmt)
 
 
-def derive(grammar: Grammar | str | os.PathLike, seed: int = 0, attrs: dict | None = None,
-           lot: str | tuple[float, float] | list[Lot] | None = None, *,
-           max_depth: int = DEFAULT_MAX_DEPTH, max_shapes: int = DEFAULT_MAX_SHAPES,
-           start: str | None = None) -> Result:
+def derive(
+    grammar: Grammar | str | os.PathLike,
+    seed: int = 0,
+    attrs: dict | None = None,
+    lot: str | tuple[float, float] | list[Lot] | None = None,
+    *,
+    max_depth: int = DEFAULT_MAX_DEPTH,
+    max_shapes: int = DEFAULT_MAX_SHAPES,
+    start: str | None = None,
+) -> Result:
     """Derive a grammar on one lot or several.
 
     ``grammar`` is a checked :class:`bgr.Grammar` or anything :func:`bgr.load` takes.  ``lot`` is
@@ -61,8 +67,13 @@ def derive(grammar: Grammar | str | os.PathLike, seed: int = 0, attrs: dict | No
     shared_cache: dict = {}
     for i, each in enumerate(lots):
         overrides = dict(attrs)
-        overrides.update({k: v for k, v in each.properties.items() if k in grammar.attrs
-                          and isinstance(v, (int, float, str, bool)) and v is not None})
+        overrides.update(
+            {
+                k: v
+                for k, v in each.properties.items()
+                if k in grammar.attrs and isinstance(v, (int, float, str, bool)) and v is not None
+            }
+        )
         engine = Engine(grammar, seed, overrides, max_depth, max_shapes, lot_index=i)
         engine.table = table
         engine.split_cache = shared_cache
@@ -70,8 +81,14 @@ def derive(grammar: Grammar | str | os.PathLike, seed: int = 0, attrs: dict | No
         engine.derive(shape, start, index=i, several=len(lots) > 1)
         lot_shape = each.shape  # its frame: the inverse modules read a face's side in it
         name = start or grammar.start
-        table.lots.append({"path": f"{name}.{i}" if len(lots) > 1 else name, "origin": list(lot_shape.origin),
-                           "axes": [list(a) for a in lot_shape.axes], "size": list(lot_shape.size)})
+        table.lots.append(
+            {
+                "path": f"{name}.{i}" if len(lots) > 1 else name,
+                "origin": list(lot_shape.origin),
+                "axes": [list(a) for a in lot_shape.axes],
+                "size": list(lot_shape.size),
+            }
+        )
     values = Engine(grammar, seed, attrs, max_depth, max_shapes).attrs if lots else attrs
     return Result(table.freeze(), seed, values)
 
@@ -79,7 +96,11 @@ def derive(grammar: Grammar | str | os.PathLike, seed: int = 0, attrs: dict | No
 def _lots(lot) -> list[Lot]:
     if lot is None:
         return [rectangle(*DEFAULT_LOT)]
-    if isinstance(lot, (tuple, list)) and len(lot) == 2 and all(isinstance(v, (int, float)) for v in lot):
+    if (
+        isinstance(lot, (tuple, list))
+        and len(lot) == 2
+        and all(isinstance(v, (int, float)) for v in lot)
+    ):
         return [rectangle(float(lot[0]), float(lot[1]))]
     if isinstance(lot, (str, os.PathLike)):
         return parse_lot_option(str(lot))

@@ -11,7 +11,15 @@ from __future__ import annotations
 import gc
 
 from bgr.grammar import nodes as n
-from bgr.grammar.registry import AXES, AXIS, COMP_KIND, FOOTPRINT_KIND, GEOMETRY, OPERATIONS, ROOF_KIND
+from bgr.grammar.registry import (
+    AXES,
+    AXIS,
+    COMP_KIND,
+    FOOTPRINT_KIND,
+    GEOMETRY,
+    OPERATIONS,
+    ROOF_KIND,
+)
 
 from bgr.grammar.errors import BgrError, Diagnostic, suggest
 
@@ -35,6 +43,8 @@ def _name_hash(name: str) -> int:
     if found is None:
         found = _NAME_HASHES[name] = name_hash(name)
     return found
+
+
 DEFAULT_MAX_DEPTH = 256
 DEFAULT_MAX_SHAPES = 10_000_000
 
@@ -42,9 +52,15 @@ DEFAULT_MAX_SHAPES = 10_000_000
 class Engine:
     """Derives one grammar with one seed and one set of attrs; reusable for several lots."""
 
-    def __init__(self, grammar, seed: int = 0, attrs: dict | None = None,
-                 max_depth: int = DEFAULT_MAX_DEPTH, max_shapes: int = DEFAULT_MAX_SHAPES,
-                 lot_index: int = 0) -> None:
+    def __init__(
+        self,
+        grammar,
+        seed: int = 0,
+        attrs: dict | None = None,
+        max_depth: int = DEFAULT_MAX_DEPTH,
+        max_shapes: int = DEFAULT_MAX_SHAPES,
+        lot_index: int = 0,
+    ) -> None:
         self.grammar, self.seed, self.lot_index = grammar, seed, lot_index
         self.max_depth, self.max_shapes = max_depth, max_shapes
         self.compilers: dict[int, Compiler] = {}
@@ -56,14 +72,23 @@ class Engine:
         self._flat_ids: dict[tuple, int] = {}
         self.split_cache: dict = {}  # (block id, sizes, length) -> placed pieces
         self.signatures: dict[int, tuple] = {}
-        self.uses_center: dict[int, bool] = {}  # id(step list) -> does it call center()?  # id(operation node) -> its signature (the grammar outlives us)
+        self.uses_center: dict[
+            int, bool
+        ] = {}  # id(step list) -> does it call center()?  # id(operation node) -> its signature (the grammar outlives us)
 
     def _prepare_values(self, grammar, overrides: dict) -> dict:
         unknown = [k for k in overrides if k not in grammar.attrs]
         if unknown:
-            hint = suggest(unknown[0], grammar.attrs) or ("attrs: " + ", ".join(grammar.attrs) if grammar.attrs
-                                                          else "the grammar declares no attrs")
-            raise BgrError(Diagnostic(grammar.path, 0, 0, f"the grammar has no attr '{unknown[0]}' to set", hint))
+            hint = suggest(unknown[0], grammar.attrs) or (
+                "attrs: " + ", ".join(grammar.attrs)
+                if grammar.attrs
+                else "the grammar declares no attrs"
+            )
+            raise BgrError(
+                Diagnostic(
+                    grammar.path, 0, 0, f"the grammar has no attr '{unknown[0]}' to set", hint
+                )
+            )
         seen = set()
 
         def prepare(g, over):
@@ -73,6 +98,7 @@ class Engine:
             for sub in g.imports.values():
                 prepare(sub, {})
             evaluate_values(g, over, self.compilers, self.seed, self.lot_index)
+
         prepare(grammar, overrides)
         values = self.compilers[id(grammar)].values
         return {k: values[k] for k in grammar.attrs}
@@ -86,7 +112,9 @@ class Engine:
         return fn
 
     # ---- the loop ------------------------------------------------------------------------------
-    def derive(self, lot: Shape, rule: str | None = None, index: int = 0, several: bool = False) -> TerminalTable:
+    def derive(
+        self, lot: Shape, rule: str | None = None, index: int = 0, several: bool = False
+    ) -> TerminalTable:
         """Derive the start rule (or ``rule``) on a lot; ``index`` numbers lots of one run."""
         grammar = self.grammar
         start = rule or grammar.start
@@ -96,10 +124,13 @@ class Engine:
         head = grammar.rules[start]
         required = [p for i, p in enumerate(head.params) if head.default(i) is None]
         if required:
-            raise runtime_error(grammar, head.pos,
-                                f"the start rule '{start}' needs a value for {', '.join(required)}, "
-                                "but the lot comes with none",
-                                "give the parameters defaults ('w = 10'), or start from a rule that calls this one")
+            raise runtime_error(
+                grammar,
+                head.pos,
+                f"the start rule '{start}' needs a value for {', '.join(required)}, "
+                "but the lot comes with none",
+                "give the parameters defaults ('w = 10'), or start from a rule that calls this one",
+            )
         lot.path = f"{start}.{index}" if several else start
         lot.hash = child_hash(root_hash(self.seed), name_hash(start), index)
         stack = [(lot, grammar, grammar.rules[start], {}, (0, 1, 0, 1, 0.0, 0.0))]
@@ -134,8 +165,12 @@ class Engine:
     def count_shape(self, module, pos) -> None:
         self.shapes += 1
         if self.shapes > self.max_shapes:
-            raise runtime_error(module, pos, f"the derivation made more than {self.max_shapes:,} shapes",
-                                "a rule multiplies shapes without end? Raise the budget with --max-shapes N")
+            raise runtime_error(
+                module,
+                pos,
+                f"the derivation made more than {self.max_shapes:,} shapes",
+                "a rule multiplies shapes without end? Raise the budget with --max-shapes N",
+            )
 
     # ---- terminals -------------------------------------------------------------------------------
     def emit(self, shape: Shape, label: str, rule: str) -> None:
@@ -179,8 +214,15 @@ class Engine:
 class Application:
     """One rule applied to one shape: runs the body's steps and collects the children."""
 
-    def __init__(self, engine: Engine, shape: Shape, module, rule: n.Rule, args: dict,
-                 indices=(0, 1, 0, 1, 0.0, 0.0)) -> None:
+    def __init__(
+        self,
+        engine: Engine,
+        shape: Shape,
+        module,
+        rule: n.Rule,
+        args: dict,
+        indices=(0, 1, 0, 1, 0.0, 0.0),
+    ) -> None:
         self.engine, self.shape, self.module, self.rule = engine, shape, module, rule
         self.compiler = engine.compilers[id(module)]
         self.local = frozenset(rule.params)
@@ -197,7 +239,9 @@ class Application:
         rule = self.rule
         for i, p in enumerate(rule.params):
             if p not in args:
-                fn = self.engine.compiled(self.compiler, rule.default(i), frozenset(rule.params[:i]))
+                fn = self.engine.compiled(
+                    self.compiler, rule.default(i), frozenset(rule.params[:i])
+                )
                 args[p] = fn(self.ctx)
 
     def value(self, node):
@@ -217,11 +261,16 @@ class Application:
                     continue
                 p = self.value(choice.prob)
                 if isinstance(p, bool) or not isinstance(p, (int, float)) or p < 0:
-                    raise runtime_error(self.module, choice.pos,
-                                        f"a percentage must be a number from 0 to 100, got {p!r}")
+                    raise runtime_error(
+                        self.module,
+                        choice.pos,
+                        f"a percentage must be a number from 0 to 100, got {p!r}",
+                    )
                 acc += p
                 if acc > 100 + 1e-9:
-                    raise runtime_error(self.module, choice.pos, f"the percentages add up to {acc:g}%, over 100%")
+                    raise runtime_error(
+                        self.module, choice.pos, f"the percentages add up to {acc:g}%, over 100%"
+                    )
                 if chosen is None and draw < acc:
                     chosen = choice
             if chosen is not None:  # no else and a draw past the percentages: deleted, as NIL
@@ -257,7 +306,9 @@ class Application:
                 # the last step may hand the shape itself over: nothing uses it afterwards
                 self.successor(shape, step, handover=step is last)
                 consumed = True
-            elif isinstance(step, n.Nil):  # the shape is deleted: later steps have nothing to work on
+            elif isinstance(
+                step, n.Nil
+            ):  # the shape is deleted: later steps have nothing to work on
                 self.ctx.shape = shape
                 return True
             elif isinstance(step, n.Push):
@@ -271,7 +322,9 @@ class Application:
         key = id(steps)
         found = uses.get(key)
         if found is None:
-            found = uses[key] = any(isinstance(s, n.Operation) and s.name == "center" for s in steps)
+            found = uses[key] = any(
+                isinstance(s, n.Operation) and s.name == "center" for s in steps
+            )
         return shape.copy() if found else None
 
     def arguments(self, step: n.Operation, received: Shape) -> list:
@@ -282,14 +335,19 @@ class Application:
         if plan is None:
             plan = self.engine.signatures[id(step)] = self.plan(step)
         ctx = self.ctx
-        out = [value if kind == 0 else fn(ctx) if kind == 1 else ("rel", fn(ctx)) for kind, value, fn in plan]
+        out = [
+            value if kind == 0 else fn(ctx) if kind == 1 else ("rel", fn(ctx))
+            for kind, value, fn in plan
+        ]
         out.append(received)
         return out
 
     def plan(self, step: n.Operation) -> tuple:
         """(kind, constant, compiled) per parameter: 0 a word or a default, 1 a value, 2 relative."""
         spec, count = OPERATIONS[step.name], len(step.args)
-        sig = next(s for s, (least, most) in zip(spec.signatures, spec.arities()) if least <= count <= most)
+        sig = next(
+            s for s, (least, most) in zip(spec.signatures, spec.arities()) if least <= count <= most
+        )
         plan = []
         for i, param in enumerate(sig):
             if i >= count:
@@ -322,33 +380,61 @@ class Application:
         engine = self.engine
         engine.count_shape(self.module, step.pos)
         if child.depth > engine.max_depth:
-            raise runtime_error(self.module, step.pos,
-                                f"the derivation is deeper than {engine.max_depth} rules (at '{step.name}')",
-                                "a rule calls itself without end? Raise the limit with --max-depth N")
+            raise runtime_error(
+                self.module,
+                step.pos,
+                f"the derivation is deeper than {engine.max_depth} rules (at '{step.name}')",
+                "a rule calls itself without end? Raise the limit with --max-depth N",
+            )
         if member in module.terminals:
             child.label = child.label or member
             self.children.append((EMIT, child, member, member))
             return
         rule = module.rules[member]
         ctx = self.ctx
-        self.children.append((child, module, rule, args,
-                              (ctx.split_index, ctx.split_total, ctx.comp_index, ctx.comp_total,
-                               ctx.comp_left, ctx.comp_right)))
+        self.children.append(
+            (
+                child,
+                module,
+                rule,
+                args,
+                (
+                    ctx.split_index,
+                    ctx.split_total,
+                    ctx.comp_index,
+                    ctx.comp_total,
+                    ctx.comp_left,
+                    ctx.comp_right,
+                ),
+            )
+        )
 
     def target(self, step: n.Successor):
         """The (module, rule name) a parameter used as a successor holds."""
         ref = self.ctx.args[step.name]
         if not isinstance(ref, RuleRef):
-            shown = f'the string "{ref}"' if isinstance(ref, str) else f"the value {ref:g}" if isinstance(
-                ref, float) else repr(ref)
-            raise runtime_error(self.module, step.pos,
-                                f"parameter '{step.name}' is applied as a rule but holds {shown}",
-                                f"pass a rule: {self.rule.name}({step.name} = SomeRule)")
+            shown = (
+                f'the string "{ref}"'
+                if isinstance(ref, str)
+                else f"the value {ref:g}"
+                if isinstance(ref, float)
+                else repr(ref)
+            )
+            raise runtime_error(
+                self.module,
+                step.pos,
+                f"parameter '{step.name}' is applied as a rule but holds {shown}",
+                f"pass a rule: {self.rule.name}({step.name} = SomeRule)",
+            )
         if step.args or ref.member in ref.module.rules:
             problem = self.engine.binding_problem(ref, step)
             if problem is not None:
-                raise runtime_error(self.module, step.pos, problem[1] + f" (held by parameter '{step.name}')",
-                                    problem[2])
+                raise runtime_error(
+                    self.module,
+                    step.pos,
+                    problem[1] + f" (held by parameter '{step.name}')",
+                    problem[2],
+                )
         return ref.module, ref.member
 
     def bind(self, module, member: str, step: n.Successor) -> dict:
@@ -368,11 +454,24 @@ class Application:
     def piece(self, shape: Shape, body: n.Sequence, split=None, comp=None) -> None:
         """Run a block entry's steps on one piece (a split piece, a face, an inset)."""
         ctx = self.ctx
-        saved = (ctx.split_index, ctx.split_total, ctx.comp_index, ctx.comp_total, ctx.comp_left, ctx.comp_right)
+        saved = (
+            ctx.split_index,
+            ctx.split_total,
+            ctx.comp_index,
+            ctx.comp_total,
+            ctx.comp_left,
+            ctx.comp_right,
+        )
         if split is not None:
             ctx.split_index, ctx.split_total = split
         if comp is not None:
             ctx.comp_index, ctx.comp_total, ctx.comp_left, ctx.comp_right = comp
         self.sequence(shape, body.steps)
-        (ctx.split_index, ctx.split_total, ctx.comp_index, ctx.comp_total,
-         ctx.comp_left, ctx.comp_right) = saved
+        (
+            ctx.split_index,
+            ctx.split_total,
+            ctx.comp_index,
+            ctx.comp_total,
+            ctx.comp_left,
+            ctx.comp_right,
+        ) = saved

@@ -26,17 +26,37 @@ class BgrRuntimeError(BgrError):
 
 
 def runtime_error(module, pos: n.Pos, message: str, hint: str | None = None) -> BgrRuntimeError:
-    return BgrRuntimeError(Diagnostic(module.path, pos.line, pos.column, message, hint,
-                                      source_line(module.module.source, pos.line)))
+    return BgrRuntimeError(
+        Diagnostic(
+            module.path,
+            pos.line,
+            pos.column,
+            message,
+            hint,
+            source_line(module.module.source, pos.line),
+        )
+    )
 
 
 class Context:
     """What an expression can see while a shape is being derived."""
 
-    __slots__ = ("shape", "args", "stream", "seed", "split_index", "split_total",
-                 "comp_index", "comp_total", "comp_left", "comp_right")
+    __slots__ = (
+        "shape",
+        "args",
+        "stream",
+        "seed",
+        "split_index",
+        "split_total",
+        "comp_index",
+        "comp_total",
+        "comp_left",
+        "comp_right",
+    )
 
-    def __init__(self, shape, args: dict, stream, seed: int, split=(0, 1), comp=(0, 1, 0.0, 0.0)) -> None:
+    def __init__(
+        self, shape, args: dict, stream, seed: int, split=(0, 1), comp=(0, 1, 0.0, 0.0)
+    ) -> None:
         self.shape, self.args, self.stream, self.seed = shape, args, stream, seed
         self.split_index, self.split_total = split
         self.comp_index, self.comp_total, self.comp_left, self.comp_right = comp
@@ -54,7 +74,11 @@ class RuleRef:
         self.module, self.member = module, member
 
     def __eq__(self, other) -> bool:
-        return isinstance(other, RuleRef) and other.module is self.module and other.member == self.member
+        return (
+            isinstance(other, RuleRef)
+            and other.module is self.module
+            and other.member == self.member
+        )
 
     def __hash__(self) -> int:
         return hash((id(self.module), self.member))
@@ -77,19 +101,38 @@ def _show(value) -> str:
     return repr(value)  # numbers, and RuleRef: "the rule 'Arched'"
 
 
-_ARITH = {"+": operator.add, "-": operator.sub, "*": operator.mul, "/": operator.truediv,
-          "%": operator.mod, "**": operator.pow}
-_COMPARE = {"==": operator.eq, "!=": operator.ne, "<": operator.lt, "<=": operator.le,
-            ">": operator.gt, ">=": operator.ge}
+_ARITH = {
+    "+": operator.add,
+    "-": operator.sub,
+    "*": operator.mul,
+    "/": operator.truediv,
+    "%": operator.mod,
+    "**": operator.pow,
+}
+_COMPARE = {
+    "==": operator.eq,
+    "!=": operator.ne,
+    "<": operator.lt,
+    "<=": operator.le,
+    ">": operator.gt,
+    ">=": operator.ge,
+}
 
 
 def _deg(f):
     return lambda x: f(math.radians(x))
 
 
-_MATH = {"floor": math.floor, "ceil": math.ceil, "abs": abs, "sqrt": math.sqrt,
-         "sin": _deg(math.sin), "cos": _deg(math.cos), "tan": _deg(math.tan),
-         "round": lambda x: math.floor(x + 0.5) if x >= 0 else -math.floor(-x + 0.5)}
+_MATH = {
+    "floor": math.floor,
+    "ceil": math.ceil,
+    "abs": abs,
+    "sqrt": math.sqrt,
+    "sin": _deg(math.sin),
+    "cos": _deg(math.cos),
+    "tan": _deg(math.tan),
+    "round": lambda x: math.floor(x + 0.5) if x >= 0 else -math.floor(-x + 0.5),
+}
 
 
 class Compiler:
@@ -161,7 +204,11 @@ class Compiler:
                 return lambda ctx: -_num(module, e.pos, f(ctx))
             return lambda ctx: +_num(module, e.pos, f(ctx))
         if isinstance(e, n.Ternary):
-            c, a, b = self.expr(e.cond, local), self.expr(e.then, local), self.expr(e.otherwise, local)
+            c, a, b = (
+                self.expr(e.cond, local),
+                self.expr(e.then, local),
+                self.expr(e.otherwise, local),
+            )
             return lambda ctx: a(ctx) if c(ctx) else b(ctx)
         if isinstance(e, n.Binary):
             return self.binary(e, local)
@@ -184,7 +231,10 @@ class Compiler:
                 try:
                     return cmp(a, b)
                 except TypeError:
-                    raise runtime_error(module, pos, f"cannot compare {_show(a)} with {_show(b)}") from None
+                    raise runtime_error(
+                        module, pos, f"cannot compare {_show(a)} with {_show(b)}"
+                    ) from None
+
             return compare
         fn = _ARITH[e.op]
         op = e.op
@@ -196,38 +246,46 @@ class Compiler:
             try:
                 result = fn(_num(module, pos, a), _num(module, pos, b))
             except ZeroDivisionError:
-                raise runtime_error(module, pos, "division by zero",
-                                    "guard the divisor, e.g. x / max(n, 1)") from None
+                raise runtime_error(
+                    module, pos, "division by zero", "guard the divisor, e.g. x / max(n, 1)"
+                ) from None
             except OverflowError:
                 raise runtime_error(module, pos, "the result is too large") from None
             if isinstance(result, complex):
                 raise runtime_error(module, pos, "a negative number to a fractional power")
             return result
+
         return arith
 
     def call(self, e: n.Call, local: frozenset) -> Compiled:
         module, pos, name = self.module, e.pos, e.name
         args = [self.expr(a, local) for a in e.args]
         if name == "rand":
+
             def rand(ctx):
                 vals = [_num(module, pos, a(ctx)) for a in args]
                 lo, hi = (0.0, 1.0) if not vals else ((0.0, vals[0]) if len(vals) == 1 else vals)
                 return lo + (hi - lo) * ctx.stream.uniform()
+
             return rand
         if name == "randint":
+
             def randint(ctx):
                 lo, hi = (math.ceil(_num(module, pos, a(ctx))) for a in args)
                 if hi < lo:
                     raise runtime_error(module, pos, f"randint({lo}, {hi}): the range is empty")
                 return lo + min(int(ctx.stream.uniform() * (hi - lo + 1)), hi - lo)
+
             return randint
         if name in ("min", "max"):
             fn = min if name == "min" else max
             return lambda ctx: fn(_num(module, pos, a(ctx)) for a in args)
         if name == "clamp":
             x, lo, hi = args
-            return lambda ctx: min(max(_num(module, pos, x(ctx)), _num(module, pos, lo(ctx))),
-                                   _num(module, pos, hi(ctx)))
+            return lambda ctx: min(
+                max(_num(module, pos, x(ctx)), _num(module, pos, lo(ctx))),
+                _num(module, pos, hi(ctx)),
+            )
         if name in _MATH:
             fn, (a,) = _MATH[name], args
 
@@ -236,6 +294,7 @@ class Compiler:
                     return fn(_num(module, pos, a(ctx)))
                 except (ValueError, OverflowError):
                     raise runtime_error(module, pos, f"{name}() of {a(ctx)} is undefined") from None
+
             return math_call
         # a func of this module or of an imported one
         target, member = module.lookup_module(name)
@@ -257,14 +316,22 @@ class Compiler:
             try:
                 return body(ctx)
             except RecursionError:
-                raise runtime_error(caller, pos, f"function '{name}' calls itself without end") from None
+                raise runtime_error(
+                    caller, pos, f"function '{name}' calls itself without end"
+                ) from None
             finally:
                 ctx.args = saved
+
         return call
 
 
-def evaluate_values(grammar, overrides: dict[str, Value], modules: dict[int, Compiler],
-                    seed: int = 0, lot_index: int = 0) -> dict[str, Value]:
+def evaluate_values(
+    grammar,
+    overrides: dict[str, Value],
+    modules: dict[int, Compiler],
+    seed: int = 0,
+    lot_index: int = 0,
+) -> dict[str, Value]:
     """Evaluate a module's attrs and consts in dependency order (attrs may be overridden).
 
     rand() in an attr draws from a stream of the seed, the lot and the attr's own name: each lot
@@ -286,13 +353,21 @@ def evaluate_values(grammar, overrides: dict[str, Value], modules: dict[int, Com
             for dep in n.names_in(item.value):
                 if dep.name in pending:
                     get(dep.name)
-            ctx.stream = Stream(child_hash(root_hash(seed), name_hash(Path(grammar.path).stem + "." + name), lot_index))
+            ctx.stream = Stream(
+                child_hash(
+                    root_hash(seed), name_hash(Path(grammar.path).stem + "." + name), lot_index
+                )
+            )
             try:
                 values[name] = compiler.expr(item.value)(ctx)
             except AttributeError:  # a func that reads the shape, called where there is none
-                raise runtime_error(grammar, item.pos, f"'{name}' reads the shape (scope.*, depth) through a "
-                                    "function, but attrs and consts are evaluated before any shape exists",
-                                    "compute it in a rule instead") from None
+                raise runtime_error(
+                    grammar,
+                    item.pos,
+                    f"'{name}' reads the shape (scope.*, depth) through a "
+                    "function, but attrs and consts are evaluated before any shape exists",
+                    "compute it in a rule instead",
+                ) from None
         return values[name]
 
     for name in pending:

@@ -43,7 +43,9 @@ def footprint(points_xz: list[tuple[float, float]], properties: dict | None = No
     xa = (ex / length, 0.0, ez / length)
     za = (-xa[2], 0.0, xa[0])  # z = x cross y with y up: the frame (xa, up, za) is right-handed
     # z must point into the lot: if the interior is on the other side, walk the ring backwards
-    local = [((x - x0) * xa[0] + (z - z0) * xa[2], (x - x0) * za[0] + (z - z0) * za[2]) for x, z in pts]
+    local = [
+        ((x - x0) * xa[0] + (z - z0) * xa[2], (x - x0) * za[0] + (z - z0) * za[2]) for x, z in pts
+    ]
     centroid_w = sum(w for _, w in local) / len(local)
     if centroid_w < 0:
         return footprint([pts[1], pts[0], *reversed(pts[2:])], properties)
@@ -60,8 +62,10 @@ def parse_lot_option(value: str) -> list[Lot]:
         try:
             width, depth = (float(v) for v in value.split(","))
         except ValueError:
-            raise BgrError(f"--lot {value}: write the lot as WIDTH,DEPTH in metres (e.g. 20,30) "
-                           "or give a GeoJSON file") from None
+            raise BgrError(
+                f"--lot {value}: write the lot as WIDTH,DEPTH in metres (e.g. 20,30) "
+                "or give a GeoJSON file"
+            ) from None
         return [rectangle(width, depth)]
     return read_geojson(Path(value))
 
@@ -80,7 +84,9 @@ def read_geojson(path: Path) -> list[Lot]:
     if isinstance(data, dict) and data.get("type") == "Feature":
         features = [data]
     if not isinstance(features, list):
-        raise BgrError(Diagnostic(shown, 0, 0, "a lot file must be a GeoJSON FeatureCollection or Feature"))
+        raise BgrError(
+            Diagnostic(shown, 0, 0, "a lot file must be a GeoJSON FeatureCollection or Feature")
+        )
     rings = []
     for i, feature in enumerate(features):
         geometry = (feature or {}).get("geometry") or {}
@@ -91,7 +97,9 @@ def read_geojson(path: Path) -> list[Lot]:
             elif kind == "MultiPolygon":
                 rings += [(poly[0], feature.get("properties") or {}, i) for poly in coords]
         except (TypeError, IndexError):
-            raise BgrError(Diagnostic(shown, 0, 0, f"feature {i}: malformed {kind} coordinates")) from None
+            raise BgrError(
+                Diagnostic(shown, 0, 0, f"feature {i}: malformed {kind} coordinates")
+            ) from None
     if not rings:
         raise BgrError(Diagnostic(shown, 0, 0, "the lot file has no Polygon features"))
     try:
@@ -99,15 +107,23 @@ def read_geojson(path: Path) -> list[Lot]:
     except (TypeError, ValueError, IndexError):
         raise BgrError(Diagnostic(shown, 0, 0, "coordinates must be [x, y] numbers")) from None
     xs, ys = [x for x, _ in flat], [y for _, y in flat]
-    geographic = (all(abs(x) <= 180 and abs(y) <= 90 for x, y in flat)
-                  and max(xs) - min(xs) < 1.0 and max(ys) - min(ys) < 1.0)
+    geographic = (
+        all(abs(x) <= 180 and abs(y) <= 90 for x, y in flat)
+        and max(xs) - min(xs) < 1.0
+        and max(ys) - min(ys) < 1.0
+    )
     lon0 = sum(x for x, _ in flat) / len(flat)
     lat0 = sum(y for _, y in flat) / len(flat)
     kx, ky = (111_320.0 * math.cos(math.radians(lat0)), 110_540.0) if geographic else (1.0, 1.0)
     lots = []
     for ring, props, i in rings:
-        pts = [((float(c[0]) - (lon0 if geographic else 0)) * kx, -(float(c[1]) - (lat0 if geographic else 0)) * ky)
-               for c in ring]
+        pts = [
+            (
+                (float(c[0]) - (lon0 if geographic else 0)) * kx,
+                -(float(c[1]) - (lat0 if geographic else 0)) * ky,
+            )
+            for c in ring
+        ]
         try:
             lots.append(footprint(pts, props))
         except BgrError as e:

@@ -43,11 +43,33 @@ class Solid:
 class Shape:
     """One shape of the derivation.  Copied, never shared, between parent and children."""
 
-    __slots__ = ("origin", "axes", "size", "geom", "color", "material", "label",
-                 "path", "hash", "depth", "frame")
+    __slots__ = (
+        "origin",
+        "axes",
+        "size",
+        "geom",
+        "color",
+        "material",
+        "label",
+        "path",
+        "hash",
+        "depth",
+        "frame",
+    )
 
-    def __init__(self, origin, axes, size, geom, color=(0.8, 0.8, 0.8), material=None, label=None,
-                 path="", hash_=0, depth=0) -> None:
+    def __init__(
+        self,
+        origin,
+        axes,
+        size,
+        geom,
+        color=(0.8, 0.8, 0.8),
+        material=None,
+        label=None,
+        path="",
+        hash_=0,
+        depth=0,
+    ) -> None:
         self.origin: list[float] = list(origin)
         self.axes: tuple[Vec, Vec, Vec] = axes
         self.size: list[float] = list(size)
@@ -61,8 +83,18 @@ class Shape:
         self.frame = None  # (origin, axes) of the shape this one was cut from; None: the world
 
     def copy(self) -> "Shape":
-        twin = Shape(self.origin, self.axes, self.size, self.geom, self.color, self.material,
-                     self.label, self.path, self.hash, self.depth)
+        twin = Shape(
+            self.origin,
+            self.axes,
+            self.size,
+            self.geom,
+            self.color,
+            self.material,
+            self.label,
+            self.path,
+            self.hash,
+            self.depth,
+        )
         twin.frame = self.frame
         return twin
 

@@ -69,6 +69,7 @@ def _pieces(items):
 
 # ---- step 1-3: sizes ----------------------------------------------------------------------------
 
+
 def _to_absolute(item: Item, length: float) -> Item:
     """Step 1: relative sizes become absolute (fractions of the whole split's length)."""
     if isinstance(item, Repeat):
@@ -105,10 +106,16 @@ def _nominal(group: Repeat, length: float) -> tuple[float, float]:
 def _resolve(items: list[Item], length: float) -> list[tuple[Item, float]]:
     """Every item of one level with its final size (a group is expanded into its repetitions)."""
     groups = [it for it in items if isinstance(it, Repeat)]
-    abs_out = sum(max(_absolute(it, length)[1], 0.0) for it in items
-                  if isinstance(it, Piece) and not _absolute(it, length)[0])
-    float_out = sum(max(_absolute(it, length)[1], 0.0) for it in items
-                    if isinstance(it, Piece) and _absolute(it, length)[0])
+    abs_out = sum(
+        max(_absolute(it, length)[1], 0.0)
+        for it in items
+        if isinstance(it, Piece) and not _absolute(it, length)[0]
+    )
+    float_out = sum(
+        max(_absolute(it, length)[1], 0.0)
+        for it in items
+        if isinstance(it, Piece) and _absolute(it, length)[0]
+    )
     avail = length - abs_out
     counts: dict[int, int] = {}
     scale = 1.0
@@ -137,12 +144,18 @@ def _repetitions(groups: list[Repeat], avail: float, float_out: float, length: f
     floating = float_out + sum(f for _, f in nominal) > 0
     if avail <= EPS or per_rep <= EPS:
         return {id(g): (1 if avail > EPS else 0) for g in groups}, (
-            max(avail, 0.0) / (float_out + sum(f for _, f in nominal)) if floating and avail > EPS else 0.0)
+            max(avail, 0.0) / (float_out + sum(f for _, f in nominal))
+            if floating and avail > EPS
+            else 0.0
+        )
     if not floating:  # absolute repeats: as many whole repetitions as fit
         k = max(int(math.floor(avail / per_rep + EPS)), 0)
         return {id(g): k for g in groups}, 1.0
-    patterns = (itertools.product((0, 1), repeat=len(groups)) if len(groups) <= MAX_GROUPS_EXACT
-                else [tuple([0] * len(groups)), tuple([1] * len(groups))])
+    patterns = (
+        itertools.product((0, 1), repeat=len(groups))
+        if len(groups) <= MAX_GROUPS_EXACT
+        else [tuple([0] * len(groups)), tuple([1] * len(groups))]
+    )
     best = None
     for extra in patterns:
         extra_len = sum(e * (a + f) for e, (a, f) in zip(extra, nominal))
@@ -172,9 +185,17 @@ def _fill_remainder(sized, groups, avail, length):
     left = avail - used
     if left <= EPS:
         return sized
-    last = max(i for i, (item, _) in enumerate(sized) if isinstance(item, Repeat)) if used > 0 else None
+    last = (
+        max(i for i, (item, _) in enumerate(sized) if isinstance(item, Repeat))
+        if used > 0
+        else None
+    )
     group = groups[-1] if last is None else sized[last][0]
-    insert_at = (last + 1) if last is not None else next(i for i, (it, _) in enumerate(sized) if it is group) + 0
+    insert_at = (
+        (last + 1)
+        if last is not None
+        else next(i for i, (it, _) in enumerate(sized) if it is group) + 0
+    )
     if last is None:  # no whole repetition fitted: the group's only repetition is the cut one
         sized = [(it, sz) for it, sz in sized if it is not group or sz > 0]
     return sized[:insert_at] + [(_Cut(group, left), left)] + sized[insert_at:]
@@ -189,6 +210,7 @@ class _Cut:
 
 
 # ---- steps 4-6: placing -------------------------------------------------------------------------
+
 
 def _lay_out(sized, start: float, end: float, out: list[Placed]) -> float:
     """Place items from ``start``; pieces overflowing ``end`` are cut, later ones not created."""

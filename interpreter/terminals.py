@@ -58,7 +58,9 @@ class TerminalTable:
     material: list = field(default_factory=list)  # str or None
     mesh: list = field(default_factory=list)  # frozen: (N,) int32 ids into library
     library: MeshLibrary = field(default_factory=MeshLibrary)
-    lots: list = field(default_factory=list)  # per lot: {"path", "origin", "axes", "size"} (its frame)
+    lots: list = field(
+        default_factory=list
+    )  # per lot: {"path", "origin", "axes", "size"} (its frame)
     frozen: bool = False
 
     def __len__(self) -> int:

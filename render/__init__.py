@@ -54,7 +54,9 @@ __all__ = [
 ]
 
 
-def make_camera(view: str | os.PathLike | Camera, scene: Scene, size: tuple[int, int] | None = None) -> Camera:
+def make_camera(
+    view: str | os.PathLike | Camera, scene: Scene, size: tuple[int, int] | None = None
+) -> Camera:
     """The camera for ``view``: a preset name (fitted to the scene), a Camera, or a camera .json
     path.  ``size`` replaces the camera's image size when given."""
     if isinstance(view, Camera):
@@ -64,15 +66,21 @@ def make_camera(view: str | os.PathLike | Camera, scene: Scene, size: tuple[int,
         return Camera.preset(view, lo, hi, size or DEFAULT_SIZE)
     if isinstance(view, (str, os.PathLike)) and str(view).lower().endswith(".json"):
         return Camera.from_json(view, size)
-    raise BgrError(f"unknown view '{view}'; give {', '.join(PRESETS)}, a Camera or a camera .json file")
+    raise BgrError(
+        f"unknown view '{view}'; give {', '.join(PRESETS)}, a Camera or a camera .json file"
+    )
 
 
 def _warn(reason: str) -> None:
     warnings.warn(f"bgr.render: {reason}; using the numpy rasteriser", RuntimeWarning, stacklevel=3)
 
 
-def rasterise(scene: Scene, camera: Camera, backend: str = "auto",
-              on_fallback: Callable[[str], None] | None = _warn) -> Frame:
+def rasterise(
+    scene: Scene,
+    camera: Camera,
+    backend: str = "auto",
+    on_fallback: Callable[[str], None] | None = _warn,
+) -> Frame:
     """The depth and triangle-index buffers of ``scene`` seen by ``camera``.
 
     ``backend``: ``"gl"`` (an error if no GL context can be made), ``"numpy"``, or ``"auto"``: GL
@@ -87,8 +95,15 @@ def rasterise(scene: Scene, camera: Camera, backend: str = "auto",
             return raster_gl.rasterise(scene.triangles, camera)
         except GLUnavailable as exc:
             if backend == "gl":
-                raise BgrError(Diagnostic("", 0, 0, f"the GL renderer is not available: {exc}",
-                                          "install the EGL libraries (see README.md) or use --backend numpy")) from None
+                raise BgrError(
+                    Diagnostic(
+                        "",
+                        0,
+                        0,
+                        f"the GL renderer is not available: {exc}",
+                        "install the EGL libraries (see README.md) or use --backend numpy",
+                    )
+                ) from None
             if on_fallback is not None:
                 on_fallback(str(exc))
     from . import raster_numpy
@@ -109,8 +124,16 @@ def image_of(frame: Frame, scene: Scene, mode: str) -> tuple[np.ndarray, dict | 
     raise BgrError(f"unknown mode '{mode}'; known modes: {', '.join(MODES)}")
 
 
-def _render(source: Any, mode: str, view: Any, size: tuple[int, int] | None, backend: str,
-            seed: int, attrs: dict | None, lot: Any) -> tuple[np.ndarray, dict | None]:
+def _render(
+    source: Any,
+    mode: str,
+    view: Any,
+    size: tuple[int, int] | None,
+    backend: str,
+    seed: int,
+    attrs: dict | None,
+    lot: Any,
+) -> tuple[np.ndarray, dict | None]:
     if mode not in MODES:
         raise BgrError(f"unknown mode '{mode}'; known modes: {', '.join(MODES)}")
     scene = load_scene(source, seed=seed, attrs=attrs, lot=lot)
@@ -118,9 +141,17 @@ def _render(source: Any, mode: str, view: Any, size: tuple[int, int] | None, bac
     return image_of(rasterise(scene, camera, backend), scene, mode)
 
 
-def render(source: Any, mode: str = "shaded", view: str | os.PathLike | Camera = "iso",
-           size: tuple[int, int] | None = None, backend: str = "auto", *, seed: int = 0,
-           attrs: dict | None = None, lot: Any = None) -> np.ndarray:
+def render(
+    source: Any,
+    mode: str = "shaded",
+    view: str | os.PathLike | Camera = "iso",
+    size: tuple[int, int] | None = None,
+    backend: str = "auto",
+    *,
+    seed: int = 0,
+    attrs: dict | None = None,
+    lot: Any = None,
+) -> np.ndarray:
     """An image of ``source``: a ``bgr.Result``, a :class:`Scene`, a trimesh, or the path of a
     ``.bgr`` file (derived with ``seed``, ``attrs`` and ``lot``, as ``bgr.derive`` takes them) or
     of a ``.glb``/``.gltf`` file.
@@ -134,9 +165,16 @@ def render(source: Any, mode: str = "shaded", view: str | os.PathLike | Camera =
     return _render(source, mode, view, size, backend, seed, attrs, lot)[0]
 
 
-def render_labels(source: Any, view: str | os.PathLike | Camera = "iso", size: tuple[int, int] | None = None,
-                  backend: str = "auto", *, seed: int = 0, attrs: dict | None = None,
-                  lot: Any = None) -> tuple[np.ndarray, dict]:
+def render_labels(
+    source: Any,
+    view: str | os.PathLike | Camera = "iso",
+    size: tuple[int, int] | None = None,
+    backend: str = "auto",
+    *,
+    seed: int = 0,
+    attrs: dict | None = None,
+    lot: Any = None,
+) -> tuple[np.ndarray, dict]:
     """The ``labels`` image and its legend ``{"background": "#000000", "labels": {label: colour}}``."""
     image, legend = _render(source, "labels", view, size, backend, seed, attrs, lot)
     assert legend is not None
@@ -145,7 +183,11 @@ def render_labels(source: Any, view: str | os.PathLike | Camera = "iso", size: t
 
 def _check_suffix(path: Path, suffix: str) -> None:
     if path.suffix.lower() != suffix:
-        shown = f"unknown output extension '{path.suffix}'" if path.suffix else "the output file name has no extension"
+        shown = (
+            f"unknown output extension '{path.suffix}'"
+            if path.suffix
+            else "the output file name has no extension"
+        )
         raise BgrError(Diagnostic(str(path), 0, 0, shown, f"bgr render writes {suffix} files"))
 
 

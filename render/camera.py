@@ -94,20 +94,40 @@ class Camera:
             raise BgrError(f"the field of view must be between 0 and 180 degrees, got {self.fov}")
         if self.size[0] < 1 or self.size[1] < 1:
             raise BgrError(f"the image size must be positive, got {self.size[0]}x{self.size[1]}")
-        if not np.allclose(self.rotation @ self.rotation.T, np.eye(3), atol=1e-6) or np.linalg.det(self.rotation) < 0:
-            raise BgrError("the camera rotation must be a proper rotation matrix (orthonormal rows, determinant +1)")
+        if (
+            not np.allclose(self.rotation @ self.rotation.T, np.eye(3), atol=1e-6)
+            or np.linalg.det(self.rotation) < 0
+        ):
+            raise BgrError(
+                "the camera rotation must be a proper rotation matrix (orthonormal rows, determinant +1)"
+            )
 
     # --- constructors -----------------------------------------------------------------------
 
     @classmethod
-    def from_angles(cls, yaw: float, pitch: float, roll: float, position, fov: float = 35.0,
-                    principal_point=(0.0, 0.0), size=(1024, 768)) -> Camera:
+    def from_angles(
+        cls,
+        yaw: float,
+        pitch: float,
+        roll: float,
+        position,
+        fov: float = 35.0,
+        principal_point=(0.0, 0.0),
+        size=(1024, 768),
+    ) -> Camera:
         """A camera at ``position`` (world) turned by yaw, pitch and roll in degrees."""
         return cls(fov, rotation_from_angles(yaw, pitch, roll), position, principal_point, size)
 
     @classmethod
-    def look_at(cls, position, target, up=(0.0, 1.0, 0.0), fov: float = 35.0,
-                principal_point=(0.0, 0.0), size=(1024, 768)) -> Camera:
+    def look_at(
+        cls,
+        position,
+        target,
+        up=(0.0, 1.0, 0.0),
+        fov: float = 35.0,
+        principal_point=(0.0, 0.0),
+        size=(1024, 768),
+    ) -> Camera:
         """A camera at ``position`` looking at ``target``, with ``up`` pointing up in the image."""
         position = np.asarray(position, dtype=np.float64)
         back = position - np.asarray(target, dtype=np.float64)
@@ -118,11 +138,24 @@ class Camera:
         if not np.linalg.norm(right) > 1e-9:
             raise BgrError("the camera's up direction is parallel to its viewing direction")
         right /= np.linalg.norm(right)
-        return cls(fov, np.stack([right, np.cross(back, right), back]), position, principal_point, size)
+        return cls(
+            fov, np.stack([right, np.cross(back, right), back]), position, principal_point, size
+        )
 
     @classmethod
-    def from_paper(cls, phi_x: float, phi_y: float, phi_z: float, fov: float, c_x: float, c_y: float,
-                   t_x: float, t_y: float, size=(1024, 768), scene_width: float = SCENE_WIDTH) -> Camera:
+    def from_paper(
+        cls,
+        phi_x: float,
+        phi_y: float,
+        phi_z: float,
+        fov: float,
+        c_x: float,
+        c_y: float,
+        t_x: float,
+        t_y: float,
+        size=(1024, 768),
+        scene_width: float = SCENE_WIDTH,
+    ) -> Camera:
         """The paper's eight parameters theta^C = (phi_x, phi_y, phi_z, fov, C_x, C_y, t_x, t_y).
 
         ``t = (t_x, t_y, t_z)`` is the camera position in the rotated frame, ``t_z`` from the dolly
@@ -136,9 +169,13 @@ class Camera:
     def preset(cls, name: str, lo, hi, size=(1024, 768)) -> Camera:
         """View ``front``, ``iso`` or ``top`` placed so that the box ``lo``..``hi`` fills the frame."""
         if name not in PRESETS:
-            raise BgrError(f"unknown view '{name}'; known views: {', '.join(PRESETS)}, or a camera .json file")
+            raise BgrError(
+                f"unknown view '{name}'; known views: {', '.join(PRESETS)}, or a camera .json file"
+            )
         yaw, pitch, roll, fov = PRESETS[name]
-        return fit(cls(fov, rotation_from_angles(yaw, pitch, roll), np.zeros(3), (0.0, 0.0), size), lo, hi)
+        return fit(
+            cls(fov, rotation_from_angles(yaw, pitch, roll), np.zeros(3), (0.0, 0.0), size), lo, hi
+        )
 
     @classmethod
     def from_json(cls, path: str | os.PathLike, size=None) -> Camera:
@@ -154,9 +191,13 @@ class Camera:
 
     def to_dict(self) -> dict:
         """The JSON form (with ``rotation`` as a matrix), for saving a view to tweak later."""
-        return {"fov": self.fov, "position": [round(float(v), 6) for v in self.position],
-                "rotation": [[round(float(v), 9) for v in row] for row in self.rotation],
-                "principal_point": list(self.principal_point), "size": list(self.size)}
+        return {
+            "fov": self.fov,
+            "position": [round(float(v), 6) for v in self.position],
+            "rotation": [[round(float(v), 9) for v in row] for row in self.rotation],
+            "principal_point": list(self.principal_point),
+            "size": list(self.size),
+        }
 
     # --- projection --------------------------------------------------------------------------
 
@@ -182,7 +223,9 @@ class Camera:
 
     def to_camera(self, points) -> np.ndarray:
         """(n, 3) points in camera coordinates: x right, y up, looking down -z."""
-        return (np.asarray(points, dtype=np.float64).reshape(-1, 3) - self.position) @ self.rotation.T
+        return (
+            np.asarray(points, dtype=np.float64).reshape(-1, 3) - self.position
+        ) @ self.rotation.T
 
     def project(self, points) -> tuple[np.ndarray, np.ndarray]:
         """(pixels (n, 2), depth (n,)): image positions and distances along the viewing axis.
@@ -211,7 +254,9 @@ def fit(camera: Camera, lo, hi, margin: float = MARGIN) -> Camera:
         lo, hi = np.full(3, -0.5), np.full(3, 0.5)
     extent = float(np.linalg.norm(hi - lo)) or 1.0
     centre = (lo + hi) / 2.0
-    corners = np.array([[x, y, z] for x in (lo[0], hi[0]) for y in (lo[1], hi[1]) for z in (lo[2], hi[2])])
+    corners = np.array(
+        [[x, y, z] for x in (lo[0], hi[0]) for y in (lo[1], hi[1]) for z in (lo[2], hi[2])]
+    )
     q = (corners - centre) @ camera.rotation.T
     w, h = camera.size
     tan = np.array([w / 2.0, h / 2.0]) * (1.0 - 2.0 * margin) / camera.focal
@@ -238,7 +283,18 @@ def fit(camera: Camera, lo, hi, margin: float = MARGIN) -> Camera:
 
 # --- the camera file ----------------------------------------------------------------------------
 
-KEYS = ("fov", "position", "yaw", "pitch", "roll", "rotation", "target", "up", "principal_point", "size")
+KEYS = (
+    "fov",
+    "position",
+    "yaw",
+    "pitch",
+    "roll",
+    "rotation",
+    "target",
+    "up",
+    "principal_point",
+    "size",
+)
 
 
 def _from_dict(cls, data: Any, shown: str, size) -> Camera:
@@ -246,16 +302,26 @@ def _from_dict(cls, data: Any, shown: str, size) -> Camera:
         return BgrError(Diagnostic(shown, 0, 0, message, hint))
 
     if not isinstance(data, dict):
-        raise bad("a camera file holds one JSON object", 'e.g. {"fov": 40, "position": [10, 5, -30], "yaw": 20}')
+        raise bad(
+            "a camera file holds one JSON object",
+            'e.g. {"fov": 40, "position": [10, 5, -30], "yaw": 20}',
+        )
     for key in data:
         if key not in KEYS:
-            raise bad(f"unknown camera key '{key}'", suggest(key, KEYS) or f"known keys: {', '.join(KEYS)}")
+            raise bad(
+                f"unknown camera key '{key}'",
+                suggest(key, KEYS) or f"known keys: {', '.join(KEYS)}",
+            )
 
     def number(key: str, default: float | None = None) -> float:
         value = data.get(key, default)
         if value is None:
             raise bad(f"the camera needs '{key}'")
-        if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
+        if (
+            isinstance(value, bool)
+            or not isinstance(value, (int, float))
+            or not math.isfinite(value)
+        ):
             raise bad(f"camera key '{key}' must be a number, got {json.dumps(value)}")
         return float(value)
 
@@ -263,11 +329,28 @@ def _from_dict(cls, data: Any, shown: str, size) -> Camera:
         value = data.get(key, default)
         if value is None:
             raise bad(f"the camera needs '{key}'", f"'{key}': a list of {n} numbers")
-        flat = value if key != "rotation" else (
-            [v for row in value for v in row] if isinstance(value, list) and all(isinstance(r, list) for r in value) else None)
-        if (not isinstance(flat, list) or len(flat) != n
-                or not all(isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v) for v in flat)):
-            shape = "a 3x3 matrix (a list of three rows of three numbers)" if key == "rotation" else f"a list of {n} numbers"
+        flat = (
+            value
+            if key != "rotation"
+            else (
+                [v for row in value for v in row]
+                if isinstance(value, list) and all(isinstance(r, list) for r in value)
+                else None
+            )
+        )
+        if (
+            not isinstance(flat, list)
+            or len(flat) != n
+            or not all(
+                isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v)
+                for v in flat
+            )
+        ):
+            shape = (
+                "a 3x3 matrix (a list of three rows of three numbers)"
+                if key == "rotation"
+                else f"a list of {n} numbers"
+            )
             raise bad(f"camera key '{key}' must be {shape}, got {json.dumps(value)}")
         return np.array(flat, dtype=np.float64)
 
@@ -281,25 +364,51 @@ def _from_dict(cls, data: Any, shown: str, size) -> Camera:
         if "size" in data:
             sz = vector("size", 2)
             if not all(v >= 1 and float(v).is_integer() for v in sz):
-                raise bad(f"camera key 'size' must be two positive whole numbers, got {json.dumps(data['size'])}")
+                raise bad(
+                    f"camera key 'size' must be two positive whole numbers, got {json.dumps(data['size'])}"
+                )
             size = (int(sz[0]), int(sz[1]))
     angles = [k for k in ("yaw", "pitch", "roll") if k in data]
-    ways = [k for k, there in (("rotation", "rotation" in data), ("target", "target" in data),
-                               ("yaw/pitch/roll", bool(angles))) if there]
+    ways = [
+        k
+        for k, there in (
+            ("rotation", "rotation" in data),
+            ("target", "target" in data),
+            ("yaw/pitch/roll", bool(angles)),
+        )
+        if there
+    ]
     if len(ways) > 1:
         raise bad(f"the camera gives both '{ways[0]}' and '{ways[1]}'; give one way of turning it")
     if "up" in data and "target" not in data:
         raise bad("camera key 'up' needs 'target'")
     if "rotation" in data:
         rotation = vector("rotation", 9).reshape(3, 3)
-        if not np.allclose(rotation @ rotation.T, np.eye(3), atol=1e-4) or np.linalg.det(rotation) < 0:
-            raise bad("camera key 'rotation' is not a rotation matrix (orthonormal rows, determinant +1)")
+        if (
+            not np.allclose(rotation @ rotation.T, np.eye(3), atol=1e-4)
+            or np.linalg.det(rotation) < 0
+        ):
+            raise bad(
+                "camera key 'rotation' is not a rotation matrix (orthonormal rows, determinant +1)"
+            )
         u, _, vt = np.linalg.svd(rotation)  # remove the rounding of a hand-written matrix
         return cls(fov, u @ vt, position, principal, size)
     if "target" in data:
         try:
-            return cls.look_at(position, vector("target", 3), vector("up", 3, [0.0, 1.0, 0.0]), fov, principal, size)
+            return cls.look_at(
+                position,
+                vector("target", 3),
+                vector("up", 3, [0.0, 1.0, 0.0]),
+                fov,
+                principal,
+                size,
+            )
         except BgrError as exc:
             raise bad(f"camera key 'target': {exc.message}") from None
-    return cls(fov, rotation_from_angles(number("yaw", 0.0), number("pitch", 0.0), number("roll", 0.0)),
-               position, principal, size)
+    return cls(
+        fov,
+        rotation_from_angles(number("yaw", 0.0), number("pitch", 0.0), number("roll", 0.0)),
+        position,
+        principal,
+        size,
+    )

@@ -38,7 +38,12 @@ class Frame:
 
 def empty_frame(camera: Camera, backend: str) -> Frame:
     w, h = camera.size
-    return Frame(np.full((h, w), np.inf, dtype=np.float32), np.full((h, w), -1, dtype=np.int32), camera, backend)
+    return Frame(
+        np.full((h, w), np.inf, dtype=np.float32),
+        np.full((h, w), -1, dtype=np.int32),
+        camera,
+        backend,
+    )
 
 
 def prepare(triangles: np.ndarray, camera: Camera) -> tuple[np.ndarray, float, float]:

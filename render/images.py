@@ -47,8 +47,12 @@ def shaded(frame: Frame, scene: Scene, background=BACKGROUND) -> np.ndarray:
     (Lambert, in linear light, plus an ambient term), on a light background."""
     light = LIGHT / np.linalg.norm(LIGHT)
     intensity = AMBIENT + (1.0 - AMBIENT) * np.clip(facing_normals(frame, scene) @ light, 0.0, 1.0)
-    colours = _linear_to_srgb8(_srgb_to_linear(scene.colors.astype(np.float64)) * intensity[:, None])
-    table = np.concatenate([colours, np.array([background], dtype=np.uint8)])  # index -1: background
+    colours = _linear_to_srgb8(
+        _srgb_to_linear(scene.colors.astype(np.float64)) * intensity[:, None]
+    )
+    table = np.concatenate(
+        [colours, np.array([background], dtype=np.uint8)]
+    )  # index -1: background
     return table[frame.triangle]
 
 
@@ -70,8 +74,12 @@ def face_ids(scene: Scene, normal_tol: float = 1e-3, offset_tol: float = 1e-3) -
     offset = np.einsum("ij,ij->i", n, scene.triangles[:, 0])
     rgb = scene.colors.astype(np.int64)
     look = scene.label * (1 << 24) + (rgb[:, 0] << 16) + (rgb[:, 1] << 8) + rgb[:, 2]
-    key = np.column_stack([look, np.rint(n / normal_tol), np.rint(offset / offset_tol)]).astype(np.int64)
-    order = np.lexsort(key.T[::-1])  # rows sorted; equal rows are neighbours (np.unique(axis=0) is slower)
+    key = np.column_stack([look, np.rint(n / normal_tol), np.rint(offset / offset_tol)]).astype(
+        np.int64
+    )
+    order = np.lexsort(
+        key.T[::-1]
+    )  # rows sorted; equal rows are neighbours (np.unique(axis=0) is slower)
     starts = np.empty(len(key), dtype=bool)
     starts[0] = True
     starts[1:] = (key[order[1:]] != key[order[:-1]]).any(axis=1)
@@ -148,8 +156,13 @@ def labels(frame: Frame, scene: Scene) -> tuple[np.ndarray, dict]:
     ``{"background": "#000000", "labels": {label: "#rrggbb", ...}}`` for every label of the scene
     (see :mod:`.scene` for what a label is when the source is a glTF file)."""
     colours = label_colours(scene.labels)
-    table = np.array([colours[name] for name in scene.labels] + [(0, 0, 0)], dtype=np.uint8).reshape(-1, 3)
+    table = np.array(
+        [colours[name] for name in scene.labels] + [(0, 0, 0)], dtype=np.uint8
+    ).reshape(-1, 3)
     per_triangle = np.concatenate([scene.label, [len(scene.labels)]])
     image = table[per_triangle[frame.triangle]]
-    legend = {"background": "#000000", "labels": {name: hex_colour(colours[name]) for name in sorted(colours)}}
+    legend = {
+        "background": "#000000",
+        "labels": {name: hex_colour(colours[name]) for name in sorted(colours)},
+    }
     return image, legend

@@ -71,7 +71,9 @@ def _context() -> Any:
                 ctx = moderngl.create_standalone_context(backend="egl", require=330)
                 prog = ctx.program(vertex_shader=VERTEX, fragment_shader=FRAGMENT)
             except Exception as exc:  # noqa: BLE001 - no libEGL, no device, no GL 3.3: all mean "no GL"
-                _state["error"] = f"no OpenGL context through EGL ({type(exc).__name__}: {exc})".strip()
+                _state["error"] = (
+                    f"no OpenGL context through EGL ({type(exc).__name__}: {exc})".strip()
+                )
                 raise GLUnavailable(_state["error"]) from None
             _state.update(ctx=ctx, prog=prog, targets={})
         return _state
@@ -93,13 +95,17 @@ def _targets(state: dict, size: tuple[int, int]) -> Any:
         ctx = state["ctx"]
         if max(size) > ctx.info.get("GL_MAX_RENDERBUFFER_SIZE", 16384):
             raise GLUnavailable(f"{size[0]}x{size[1]} is larger than this GL renderer allows")
-        for old in state["targets"].values():  # keep one size only: a run of sizes would fill memory
+        for old in state[
+            "targets"
+        ].values():  # keep one size only: a run of sizes would fill memory
             for attachment in (*old.color_attachments, old.depth_attachment):
                 attachment.release()
             old.release()
         ids = ctx.texture(size, 1, dtype="i4")
         depth = ctx.texture(size, 1, dtype="f4")
-        fbo = ctx.framebuffer(color_attachments=[ids, depth], depth_attachment=ctx.depth_renderbuffer(size))
+        fbo = ctx.framebuffer(
+            color_attachments=[ids, depth], depth_attachment=ctx.depth_renderbuffer(size)
+        )
         state["targets"] = {size: fbo}
     return fbo
 
@@ -129,8 +135,12 @@ def rasterise(triangles: np.ndarray, camera: Camera) -> Frame:
                 ctx.depth_func = "<"
                 fbo.clear(0.0, 0.0, 0.0, 0.0, depth=1.0)
                 vao.render(mode=ctx.TRIANGLES, vertices=3 * len(cam))
-                ids = np.frombuffer(fbo.read(components=1, attachment=0, dtype="i4"), dtype=np.int32)
-                depth = np.frombuffer(fbo.read(components=1, attachment=1, dtype="f4"), dtype=np.float32)
+                ids = np.frombuffer(
+                    fbo.read(components=1, attachment=0, dtype="i4"), dtype=np.int32
+                )
+                depth = np.frombuffer(
+                    fbo.read(components=1, attachment=1, dtype="f4"), dtype=np.float32
+                )
             finally:
                 vao.release()
         finally:
@@ -162,8 +172,10 @@ def _after_fork() -> None:
     had_context = "ctx" in _state
     _state.clear()
     if had_context:
-        _state["error"] = ("this process was forked after its parent made a GL context, which cannot "
-                           "be shared; use the 'spawn' start method for worker processes")
+        _state["error"] = (
+            "this process was forked after its parent made a GL context, which cannot "
+            "be shared; use the 'spawn' start method for worker processes"
+        )
 
 
 if hasattr(os, "register_at_fork"):

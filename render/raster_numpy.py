@@ -25,9 +25,51 @@ from .frame import Frame, empty_frame, prepare
 SUB = 256  # sub-pixel steps per pixel
 HALF = SUB // 2
 CHUNK = 1 << 21  # candidate pixels per block: bounds memory to some 50 MB
-SIZES = np.array([1, 2, 3, 4, 5, 6, 8, 10, 12, 16, 20, 24, 32, 40, 48, 64, 80, 96, 128, 160, 192, 256,
-                  320, 384, 512, 640, 768, 1024, 1280, 1536, 2048, 2560, 3072, 4096, 5120, 6144, 8192,
-                  10240, 12288, 16384, 1 << 62])
+SIZES = np.array(
+    [
+        1,
+        2,
+        3,
+        4,
+        5,
+        6,
+        8,
+        10,
+        12,
+        16,
+        20,
+        24,
+        32,
+        40,
+        48,
+        64,
+        80,
+        96,
+        128,
+        160,
+        192,
+        256,
+        320,
+        384,
+        512,
+        640,
+        768,
+        1024,
+        1280,
+        1536,
+        2048,
+        2560,
+        3072,
+        4096,
+        5120,
+        6144,
+        8192,
+        10240,
+        12288,
+        16384,
+        1 << 62,
+    ]
+)
 
 
 def clip_near(cam: np.ndarray, near: float) -> tuple[np.ndarray, np.ndarray]:
@@ -49,7 +91,7 @@ def clip_near(cam: np.ndarray, near: float) -> tuple[np.ndarray, np.ndarray]:
         odd = np.argmax(b if n_behind == 1 else ~b, axis=1)  # the corner on its own side
         roll = (odd[:, None] + np.arange(3)) % 3
         tri = np.take_along_axis(tri, roll[:, :, None], axis=1)  # the odd corner first
-        d = (-tri[:, :, 2] - near)  # signed distance to the plane
+        d = -tri[:, :, 2] - near  # signed distance to the plane
         a, b1, c = tri[:, 0], tri[:, 1], tri[:, 2]
         ab = a + (b1 - a) * (d[:, 0] / (d[:, 0] - d[:, 1]))[:, None]
         ac = a + (c - a) * (d[:, 0] / (d[:, 0] - d[:, 2]))[:, None]
@@ -91,7 +133,12 @@ def rasterise(triangles: np.ndarray, camera: Camera) -> Frame:
     if not ok.any():
         return frame
     U, V, iz, area, source = U[ok], V[ok], iz[ok], area[ok], source[ok]
-    i0, i1, j0, j1 = i0[ok].astype(np.int64), i1[ok].astype(np.int64), j0[ok].astype(np.int64), j1[ok].astype(np.int64)
+    i0, i1, j0, j1 = (
+        i0[ok].astype(np.int64),
+        i1[ok].astype(np.int64),
+        j0[ok].astype(np.int64),
+        j1[ok].astype(np.int64),
+    )
 
     # size classes; a box padded to its class is shifted back inside the image
     wc = np.minimum(SIZES[np.searchsorted(SIZES, i1 - i0 + 1)], W)
@@ -124,7 +171,7 @@ def rasterise(triangles: np.ndarray, camera: Camera) -> Frame:
         di = np.arange(wb, dtype=np.float64)
         dj = np.arange(hb, dtype=np.float64)
         for lo in range(0, len(group), step):
-            sel = group[lo:lo + step]
+            sel = group[lo : lo + step]
             inside = None
             for k in range(3):
                 row = (E0[k][sel] - THR[k][sel])[:, None] + SY[k][sel][:, None] * dj  # (n, hb)

@@ -61,7 +61,9 @@ class Scene:
 
 
 def _labels_index(names) -> tuple[np.ndarray, list[str]]:
-    labels, index = np.unique(np.asarray(list(names), dtype=object).astype(str), return_inverse=True)
+    labels, index = np.unique(
+        np.asarray(list(names), dtype=object).astype(str), return_inverse=True
+    )
     return index.reshape(-1).astype(np.int64), [str(s) for s in labels]
 
 
@@ -74,23 +76,35 @@ def from_result(result: Any) -> Scene:
     baked = bake(table)
     row = np.repeat(np.arange(len(table), dtype=np.int64), np.diff(baked.fstart))
     label_of_row, labels = _labels_index(table.label) if len(table) else (np.zeros(0, np.int64), [])
-    return Scene(triangles=baked.vertices[baked.faces], colors=srgb8(table)[row], part=row,
-                 label=label_of_row[row], labels=labels)
+    return Scene(
+        triangles=baked.vertices[baked.faces],
+        colors=srgb8(table)[row],
+        part=row,
+        label=label_of_row[row],
+        labels=labels,
+    )
 
 
-def from_trimesh(mesh: Any, material_names: list[str] | None = None,
-                 material_of_face: np.ndarray | None = None) -> Scene:
+def from_trimesh(
+    mesh: Any, material_names: list[str] | None = None, material_of_face: np.ndarray | None = None
+) -> Scene:
     """A trimesh: colours from its face colours; parts and labels by material when known, else
     by colour."""
     faces = np.asarray(mesh.faces, dtype=np.int64).reshape(-1, 3)
-    triangles = np.asarray(mesh.vertices, dtype=np.float64)[faces] if len(faces) else np.zeros((0, 3, 3))
+    triangles = (
+        np.asarray(mesh.vertices, dtype=np.float64)[faces] if len(faces) else np.zeros((0, 3, 3))
+    )
     try:
         rgb = np.asarray(mesh.visual.face_colors, dtype=np.uint8)[:, :3]
     except Exception:  # noqa: BLE001  # pragma: no cover - a visual that has no face colours
         rgb = np.full((len(faces), 3), 200, dtype=np.uint8)
     if len(rgb) != len(faces):
         rgb = np.full((len(faces), 3), 200, dtype=np.uint8)
-    if material_of_face is not None and material_names is not None and len(material_of_face) == len(faces):
+    if (
+        material_of_face is not None
+        and material_names is not None
+        and len(material_of_face) == len(faces)
+    ):
         names = [NO_LABEL if m < 0 else material_names[m] for m in range(-1, len(material_names))]
         label, labels = _labels_index(names[m + 1] for m in material_of_face)
         part = material_of_face.astype(np.int64)
@@ -112,14 +126,18 @@ def _glb_materials(gltf: dict) -> tuple[list[str], np.ndarray]:
     names = []
     for k, mat in enumerate(gltf.get("materials", [])):
         extras = mat.get("extras") if isinstance(mat.get("extras"), dict) else {}
-        names.append(extras.get("material") or mat.get("name") or extras.get("color") or f"material {k}")
+        names.append(
+            extras.get("material") or mat.get("name") or extras.get("color") or f"material {k}"
+        )
     out: list[np.ndarray] = []
 
     def visit(index: int) -> None:
         node = nodes[index]
         if "mesh" in node:
             inst = node.get("extensions", {}).get("EXT_mesh_gpu_instancing")
-            copies = gltf["accessors"][next(iter(inst["attributes"].values()))]["count"] if inst else 1
+            copies = (
+                gltf["accessors"][next(iter(inst["attributes"].values()))]["count"] if inst else 1
+            )
             for prim in meshes[node["mesh"]]["primitives"]:
                 if prim.get("mode", 4) != 4:
                     continue
@@ -154,15 +172,31 @@ def from_gltf(path: str | os.PathLike) -> Scene:
     except BgrError as exc:
         raise BgrError(Diagnostic(shown, 0, 0, exc.message, exc.hint)) from None
     except OSError as exc:
-        raise BgrError(Diagnostic(shown, 0, 0, f"cannot read the file: {exc.strerror or exc}")) from None
+        raise BgrError(
+            Diagnostic(shown, 0, 0, f"cannot read the file: {exc.strerror or exc}")
+        ) from None
     except (ValueError, KeyError, IndexError, TypeError, AttributeError, StopIteration) as exc:
-        raise BgrError(Diagnostic(shown, 0, 0, f"not a glTF 2.0 file bgr can read ({type(exc).__name__}: {exc})",
-                                  "bgr reads triangle meshes with float positions")) from None
+        raise BgrError(
+            Diagnostic(
+                shown,
+                0,
+                0,
+                f"not a glTF 2.0 file bgr can read ({type(exc).__name__}: {exc})",
+                "bgr reads triangle meshes with float positions",
+            )
+        ) from None
     return from_trimesh(mesh, names, material)
 
 
-def load_scene(source: Any, *, seed: int = 0, attrs: dict | None = None, lot: Any = None,
-               max_depth: int | None = None, max_shapes: int | None = None) -> Scene:
+def load_scene(
+    source: Any,
+    *,
+    seed: int = 0,
+    attrs: dict | None = None,
+    lot: Any = None,
+    max_depth: int | None = None,
+    max_shapes: int | None = None,
+) -> Scene:
     """A :class:`Scene` from a Scene, a ``bgr.Result``, a terminal table, a trimesh, or a path to
     a ``.bgr`` (derived with ``seed``, ``attrs`` and ``lot``), ``.glb`` or ``.gltf`` file."""
     if isinstance(source, Scene):
@@ -174,15 +208,28 @@ def load_scene(source: Any, *, seed: int = 0, attrs: dict | None = None, lot: An
             from ..grammar.loader import load
             from ..interpreter.derive import derive
 
-            limits = {k: v for k, v in (("max_depth", max_depth), ("max_shapes", max_shapes)) if v is not None}
+            limits = {
+                k: v
+                for k, v in (("max_depth", max_depth), ("max_shapes", max_shapes))
+                if v is not None
+            }
             grammar = load(path, path=str(source))
             return from_result(derive(grammar, seed=seed, attrs=attrs, lot=lot, **limits))
         if suffix in (".glb", ".gltf"):
             return from_gltf(path)
-        raise BgrError(Diagnostic(str(source), 0, 0, f"cannot render a '{suffix or 'extensionless'}' file",
-                                  "give a .bgr grammar or a .glb/.gltf model"))
+        raise BgrError(
+            Diagnostic(
+                str(source),
+                0,
+                0,
+                f"cannot render a '{suffix or 'extensionless'}' file",
+                "give a .bgr grammar or a .glb/.gltf model",
+            )
+        )
     if hasattr(source, "terminals") or hasattr(source, "library"):
         return from_result(source)
     if hasattr(source, "vertices") and hasattr(source, "faces"):
         return from_trimesh(source)
-    raise BgrError(f"cannot render a {type(source).__name__}; give a bgr Result, a trimesh or a file path")
+    raise BgrError(
+        f"cannot render a {type(source).__name__}; give a bgr Result, a trimesh or a file path"
+    )

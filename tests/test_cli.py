@@ -13,7 +13,9 @@ CLEAN = "A --> extrude(3) B\nB --> NIL\n"
 
 
 def run(*args, stdin=None):
-    return subprocess.run([sys.executable, "-m", "bgr", *args], capture_output=True, text=True, input=stdin)
+    return subprocess.run(
+        [sys.executable, "-m", "bgr", *args], capture_output=True, text=True, input=stdin
+    )
 
 
 def test_version_and_help():
@@ -28,7 +30,9 @@ def test_no_command_is_bad_usage():
 
 
 def test_check_every_shipped_grammar(root):
-    files = [str(p) for p in sorted(root.glob("examples/*.bgr")) + sorted(root.glob("stdlib/*.bgr"))]
+    files = [
+        str(p) for p in sorted(root.glob("examples/*.bgr")) + sorted(root.glob("stdlib/*.bgr"))
+    ]
     out = run("check", *files)
     assert out.returncode == 0, out.stderr
     assert out.stdout.count(": ok") == len(files)

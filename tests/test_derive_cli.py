@@ -11,17 +11,25 @@ from conftest import ROOT
 
 
 def bgr(*args, cwd=None):
-    return subprocess.run([sys.executable, "-m", "bgr", *args], capture_output=True, text=True, cwd=cwd)
+    return subprocess.run(
+        [sys.executable, "-m", "bgr", *args], capture_output=True, text=True, cwd=cwd
+    )
 
 
 def test_house_glb_loads_with_pygltflib_and_is_stable(tmp_path):
     out = tmp_path / "out.glb"
-    assert bgr("derive", str(ROOT / "examples/house.bgr"), "--seed", "3", "-o", str(out)).returncode == 0
+    assert (
+        bgr("derive", str(ROOT / "examples/house.bgr"), "--seed", "3", "-o", str(out)).returncode
+        == 0
+    )
     gltf = GLTF2().load(str(out))
     assert gltf.meshes and gltf.materials and gltf.buffers[0].byteLength > 0
     for acc in gltf.accessors:
         view = gltf.bufferViews[acc.bufferView]
-        assert view.byteOffset % 4 == 0 and view.byteOffset + view.byteLength <= gltf.buffers[0].byteLength
+        assert (
+            view.byteOffset % 4 == 0
+            and view.byteOffset + view.byteLength <= gltf.buffers[0].byteLength
+        )
 
 
 def test_set_and_lot_size(tmp_path):
@@ -34,12 +42,15 @@ def test_set_and_lot_size(tmp_path):
     assert data["terminals"][0]["size"] == [12.0, 7.5, 8.0]
 
 
-@pytest.mark.parametrize("grammar, message", [
-    ("A --> B\nB --> A\n", "deeper than 256"),
-    ("Lot --> split(x) { { 0.001: A }* }\nA --> B\nterminal B\n", "more than 1,000 shapes"),
-    ("attr n = 0\nLot --> extrude(1 / n)\n", "division by zero"),
-    ('asset col = "missing.glb"\nLot --> i(col)\n', "asset file 'missing.glb' not found"),
-])
+@pytest.mark.parametrize(
+    "grammar, message",
+    [
+        ("A --> B\nB --> A\n", "deeper than 256"),
+        ("Lot --> split(x) { { 0.001: A }* }\nA --> B\nterminal B\n", "more than 1,000 shapes"),
+        ("attr n = 0\nLot --> extrude(1 / n)\n", "division by zero"),
+        ('asset col = "missing.glb"\nLot --> i(col)\n', "asset file 'missing.glb' not found"),
+    ],
+)
 def test_runtime_faults_leave_no_file_and_no_traceback(tmp_path, grammar, message):
     src = tmp_path / "bad.bgr"
     src.write_text(grammar)

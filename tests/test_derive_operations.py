@@ -49,7 +49,9 @@ def test_taper_narrows_the_top():
 
 @pytest.mark.parametrize("kind", ["flat", "gable", "hip", "pyramid", "shed", "mansard", "gambrel"])
 def test_every_roof_kind_on_a_lot(kind):
-    t = table(f"Lot --> extrude(5) comp(f) {{ top: roof({kind}, 35, 0.3) R }}\nterminal R\n", lot=(12, 8))
+    t = table(
+        f"Lot --> extrude(5) comp(f) {{ top: roof({kind}, 35, 0.3) R }}\nterminal R\n", lot=(12, 8)
+    )
     lo, hi = bounds_of(t, 0)
     assert np.isfinite(lo).all() and np.isfinite(hi).all()
     assert lo[1] >= 5 - 0.3 * np.tan(np.radians(80)) - 1e-6  # eaves drop by the overhang at most
@@ -62,16 +64,28 @@ def test_offset_inside_and_border_tile_the_face():
     t = table("Lot --> offset(1) { inside: I | border: B }\nterminal I, B\n", lot=(10, 6))
     assert t.label == ["I", "B"]
     np.testing.assert_allclose(t.size[0], [8, 0, 4])
-    areas = [trimesh.Trimesh(world_vertices(t, np.array([i]), t.library.meshes[t.mesh[i]])[0],
-                             t.library.meshes[t.mesh[i]].faces).area for i in range(2)]
+    areas = [
+        trimesh.Trimesh(
+            world_vertices(t, np.array([i]), t.library.meshes[t.mesh[i]])[0],
+            t.library.meshes[t.mesh[i]].faces,
+        ).area
+        for i in range(2)
+    ]
     assert sum(areas) == pytest.approx(60) and areas[0] == pytest.approx(32)
 
 
 def test_colour_material_and_label_reach_the_terminal_list(tmp_path):
     src = 'Lot --> color(0, 0.5, 1) material("glass") label("Window") W\nW --> NIL G\nterminal G\n'
-    r = bgr.derive(bgr.load('Lot --> color(0, 0.5, 1) material("glass") label("Window") G\nterminal G\n'))
+    r = bgr.derive(
+        bgr.load('Lot --> color(0, 0.5, 1) material("glass") label("Window") G\nterminal G\n')
+    )
     r.save(tmp_path / "t.json")
     term = json.loads((tmp_path / "t.json").read_text())["terminals"][0]
-    assert (term["color"], term["material"], term["label"], term["rule"]) == ("#0080ff", "glass", "Window", "G")
+    assert (term["color"], term["material"], term["label"], term["rule"]) == (
+        "#0080ff",
+        "glass",
+        "Window",
+        "G",
+    )
     assert src  # the deleted variant derives to nothing
     assert len(bgr.derive(bgr.load(src))) == 0

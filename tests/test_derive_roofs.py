@@ -24,8 +24,20 @@ HEIGHT, PITCH = 6.0, 30.0
 def roof_triangles(tmp_path, name, kind):
     geo = tmp_path / f"{name}.geojson"
     ring = FOOTPRINTS[name] + [FOOTPRINTS[name][0]]
-    geo.write_text(json.dumps({"type": "FeatureCollection", "features": [
-        {"type": "Feature", "properties": {}, "geometry": {"type": "Polygon", "coordinates": [ring]}}]}))
+    geo.write_text(
+        json.dumps(
+            {
+                "type": "FeatureCollection",
+                "features": [
+                    {
+                        "type": "Feature",
+                        "properties": {},
+                        "geometry": {"type": "Polygon", "coordinates": [ring]},
+                    }
+                ],
+            }
+        )
+    )
     src = f"Lot --> extrude({HEIGHT}) comp(f) {{ top: roof({kind}, {PITCH}) Roof | side: Wall }}\nterminal Roof, Wall\n"
     t = bgr.derive(bgr.load(src), lot=str(geo)).terminals
     rows = [i for i, lab in enumerate(t.label) if lab == "Roof"]
@@ -39,7 +51,10 @@ def roof_triangles(tmp_path, name, kind):
 
 def edges(name):
     ring = FOOTPRINTS[name]
-    return [(np.array(ring[i], float), np.array(ring[(i + 1) % len(ring)], float)) for i in range(len(ring))]
+    return [
+        (np.array(ring[i], float), np.array(ring[(i + 1) % len(ring)], float))
+        for i in range(len(ring))
+    ]
 
 
 def on_edge_plane(tri, a, b, inside, tol=1e-6):
@@ -99,7 +114,9 @@ def test_roof_eaves_are_the_wall_tops(tmp_path, name, kind):
         assert len(eaves) == len(boundary)
 
 
-@pytest.mark.parametrize("w, d, overhang", [(14.3, 11.2, 0.4), (8, 12, 0), (10, 10, 0.3), (20, 3, 0.5)])
+@pytest.mark.parametrize(
+    "w, d, overhang", [(14.3, 11.2, 0.4), (8, 12, 0), (10, 10, 0.3), (20, 3, 0.5)]
+)
 def test_closed_form_rectangle_hip_matches_the_straight_skeleton(w, d, overhang):
     import trimesh
 
@@ -111,5 +128,7 @@ def test_closed_form_rectangle_hip_matches_the_straight_skeleton(w, d, overhang)
     used = lambda verts, faces: sorted(set(map(tuple, np.round(verts[np.unique(faces)], 6))))  # noqa: E731
     assert used(v, f) == used(general.vertices, general.faces)
     fast = trimesh.Trimesh(v, f, process=False)
-    assert fast.area == pytest.approx(trimesh.Trimesh(general.vertices, general.faces, process=False).area)
+    assert fast.area == pytest.approx(
+        trimesh.Trimesh(general.vertices, general.faces, process=False).area
+    )
     assert (fast.face_normals[:, 2] > 0).all()

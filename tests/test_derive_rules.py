@@ -11,8 +11,7 @@ def labels(src, **kw):
 
 
 def test_stochastic_choice_frequencies_over_ten_thousand_shapes():
-    src = ("Lot --> split(x) { { 1: W }* }\n"
-           "W --> 60%: A | 30%: B | else: C\nterminal A, B, C\n")
+    src = "Lot --> split(x) { { 1: W }* }\nW --> 60%: A | 30%: B | else: C\nterminal A, B, C\n"
     t = labels(src, lot=(10_000, 1), seed=7)
     assert len(t) == 10_000
     for name, p in (("A", 0.6), ("B", 0.3), ("C", 0.1)):
@@ -34,10 +33,14 @@ def test_same_seed_same_terminals_other_seed_other_draws():
 
 
 def test_editing_one_subtree_keeps_the_draws_of_the_others():
-    before = ("Lot --> split(x) { 10: Left | 10: Right }\n"
-              "Left --> split(x) { { 1: L }* }\nRight --> split(x) { { 1: R }* }\n"
-              "L --> s('1, rand(1, 9), '1) X\nR --> s('1, rand(1, 9), '1) Y\nterminal X, Y\n")
-    after = before.replace("L --> s('1, rand(1, 9), '1) X", "L --> 50%: s('1, rand(20, 30), '1) X | else: NIL")
+    before = (
+        "Lot --> split(x) { 10: Left | 10: Right }\n"
+        "Left --> split(x) { { 1: L }* }\nRight --> split(x) { { 1: R }* }\n"
+        "L --> s('1, rand(1, 9), '1) X\nR --> s('1, rand(1, 9), '1) Y\nterminal X, Y\n"
+    )
+    after = before.replace(
+        "L --> s('1, rand(1, 9), '1) X", "L --> 50%: s('1, rand(20, 30), '1) X | else: NIL"
+    )
     a = bgr.derive(bgr.load(before), seed=11).terminals
     b = bgr.derive(bgr.load(after), seed=11).terminals
     ya = [s[1] for s, lab in zip(a.size, a.label) if lab == "Y"]
@@ -49,8 +52,10 @@ def test_editing_one_subtree_keeps_the_draws_of_the_others():
 
 
 def test_attrs_consts_funcs_params_and_set():
-    src = ("attr h = 3\nconst k = 2\nfunc twice(x) = x * k\n"
-           "Lot --> extrude(twice(h)) M(h + 1)\nM(p) --> s(p, '1, '1) X\nterminal X\n")
+    src = (
+        "attr h = 3\nconst k = 2\nfunc twice(x) = x * k\n"
+        "Lot --> extrude(twice(h)) M(h + 1)\nM(p) --> s(p, '1, '1) X\nterminal X\n"
+    )
     t = bgr.derive(bgr.load(src)).terminals
     assert tuple(t.size[0]) == (4.0, 6.0, 20.0)
     t = bgr.derive(bgr.load(src), attrs={"h": 5}).terminals
@@ -63,8 +68,10 @@ def test_unknown_attr_in_set_is_an_error():
 
 
 def test_conditional_rules_and_depth():
-    src = ("Lot --> split(x) { { 2: P }* }\n"
-           "P --> case split.index == 0: A | case split.index < 3: B | else: C\nterminal A, B, C\n")
+    src = (
+        "Lot --> split(x) { { 2: P }* }\n"
+        "P --> case split.index == 0: A | case split.index < 3: B | else: C\nterminal A, B, C\n"
+    )
     assert labels(src, lot=(10, 1)) == ["A", "B", "B", "C", "C"]
 
 
@@ -95,8 +102,11 @@ def test_infinite_recursion_stops_with_a_clear_error():
 
 def test_shape_explosion_stops_at_the_budget():
     with pytest.raises(bgr.BgrError, match="more than 1,000 shapes"):
-        bgr.derive(bgr.load("Lot --> split(x) { { 0.01: A }* }\nA --> B\nterminal B\n"), lot=(100, 1),
-                   max_shapes=1000)
+        bgr.derive(
+            bgr.load("Lot --> split(x) { { 0.01: A }* }\nA --> B\nterminal B\n"),
+            lot=(100, 1),
+            max_shapes=1000,
+        )
 
 
 def test_division_by_zero_names_the_place():
@@ -123,7 +133,9 @@ def test_missing_asset_is_reported_at_its_declaration(tmp_path):
 
 
 def test_terminal_paths_follow_the_derivation():
-    t = bgr.derive(bgr.load("Lot --> extrude(3) comp(f) { top: Roof | side: Wall }\nterminal Roof, Wall\n")).terminals
+    t = bgr.derive(
+        bgr.load("Lot --> extrude(3) comp(f) { top: Roof | side: Wall }\nterminal Roof, Wall\n")
+    ).terminals
     assert t.path[0] == "Lot/Roof.0" and t.path[1] == "Lot/Wall.1"
 
 

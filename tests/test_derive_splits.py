@@ -12,9 +12,16 @@ from bgr.interpreter.split_solver import Piece, Repeat, solve
 
 def pieces(block: str, length: float = 10.0):
     """(label, size) of the terminals of `split(x) <block>` on a lot `length` wide."""
-    names = sorted(set(w for w in block.replace("{", " ").replace("}", " ").replace("|", " ").split()
-                       if w[:1].isupper()))
-    src = f"Lot --> split(x) {block}\n" + "".join(f"{name} --> color(\"#ffffff\")\n" for name in names)
+    names = sorted(
+        set(
+            w
+            for w in block.replace("{", " ").replace("}", " ").replace("|", " ").split()
+            if w[:1].isupper()
+        )
+    )
+    src = f"Lot --> split(x) {block}\n" + "".join(
+        f'{name} --> color("#ffffff")\n' for name in names
+    )
     result = bgr.derive(bgr.load(src), lot=(length, 5.0))
     return [(t["label"], round(t["size"][0], 6)) for t in terminal_list(result)]
 
@@ -26,35 +33,52 @@ def terminal_list(result) -> list[dict]:
     return json.loads(buffer.getvalue())["terminals"]
 
 
-@pytest.mark.parametrize("block, length, expected", [
-    ("{ 3: A | ~1: B }", 10, [("A", 3), ("B", 7)]),
-    ("{ '0.5: A | ~1: B | ~1: C }", 10, [("A", 5), ("B", 2.5), ("C", 2.5)]),
-    ("{ ~2: A }*", 10, [("A", 2)] * 5),
-    ("{ ~3: A }*", 10, [("A", round(10 / 3, 6))] * 3),
-    ("{ 1: E | { ~2: W }* | 1: E }", 10, [("E", 1)] + [("W", 2)] * 4 + [("E", 1)]),
-    ("{ 4: A | 4: B | 4: C }", 10, [("A", 4), ("B", 4), ("C", 2)]),
-    ("{ 3: A }*", 10, [("A", 3), ("A", 3), ("A", 3), ("A", 1)]),
-    ("{ 1: E | { ~1: B | 2: C }* | ~1: B | 1: E }", 12,
-     [("E", 1)] + [("B", 1), ("C", 2)] * 3 + [("B", 1), ("E", 1)]),
-    ("{ 1: E | { ~1: B | 2: C }* | ~1: B | 1: E }", 10,
-     [("E", 1)] + [("B", round(4 / 3, 6)), ("C", 2)] * 2 + [("B", round(4 / 3, 6)), ("E", 1)]),
-    ("{ 2: A | 2: B }", 10, [("A", 2), ("B", 2)]),
-])
+@pytest.mark.parametrize(
+    "block, length, expected",
+    [
+        ("{ 3: A | ~1: B }", 10, [("A", 3), ("B", 7)]),
+        ("{ '0.5: A | ~1: B | ~1: C }", 10, [("A", 5), ("B", 2.5), ("C", 2.5)]),
+        ("{ ~2: A }*", 10, [("A", 2)] * 5),
+        ("{ ~3: A }*", 10, [("A", round(10 / 3, 6))] * 3),
+        ("{ 1: E | { ~2: W }* | 1: E }", 10, [("E", 1)] + [("W", 2)] * 4 + [("E", 1)]),
+        ("{ 4: A | 4: B | 4: C }", 10, [("A", 4), ("B", 4), ("C", 2)]),
+        ("{ 3: A }*", 10, [("A", 3), ("A", 3), ("A", 3), ("A", 1)]),
+        (
+            "{ 1: E | { ~1: B | 2: C }* | ~1: B | 1: E }",
+            12,
+            [("E", 1)] + [("B", 1), ("C", 2)] * 3 + [("B", 1), ("E", 1)],
+        ),
+        (
+            "{ 1: E | { ~1: B | 2: C }* | ~1: B | 1: E }",
+            10,
+            [("E", 1)]
+            + [("B", round(4 / 3, 6)), ("C", 2)] * 2
+            + [("B", round(4 / 3, 6)), ("E", 1)],
+        ),
+        ("{ 2: A | 2: B }", 10, [("A", 2), ("B", 2)]),
+    ],
+)
 def test_contract_examples(block, length, expected):
     assert pieces(block, length) == expected
 
 
 def test_split_index_and_total_are_global_across_repetitions():
-    src = ("Lot --> split(x) { '0.1: A(split.index, split.total) | '0.1: A(split.index, split.total) }*\n"
-           "A(i, n) --> s(i + 1, n, 1)\n")
+    src = (
+        "Lot --> split(x) { '0.1: A(split.index, split.total) | '0.1: A(split.index, split.total) }*\n"
+        "A(i, n) --> s(i + 1, n, 1)\n"
+    )
     t = bgr.derive(bgr.load(src), lot=(10, 5)).terminals
     assert [int(s[0]) - 1 for s in t.size] == list(range(10))
     assert {int(s[1]) for s in t.size} == {10}
 
 
 def test_pieces_tile_the_scope_in_order():
-    t = bgr.derive(bgr.load("Lot --> split(z) { 2: A | ~1: B | 3: C }\nA --> NIL B\nB --> color(\"#000000\")\nC --> B\n"),
-                   lot=(4, 10)).terminals
+    t = bgr.derive(
+        bgr.load(
+            'Lot --> split(z) { 2: A | ~1: B | 3: C }\nA --> NIL B\nB --> color("#000000")\nC --> B\n'
+        ),
+        lot=(4, 10),
+    ).terminals
     zs = [round(float(o[2]), 9) for o in t.origin]
     sizes = [round(float(s[2]), 9) for s in t.size]
     assert (zs, sizes) == ([2.0, 7.0], [5.0, 3.0])
@@ -62,7 +86,9 @@ def test_pieces_tile_the_scope_in_order():
 
 def test_floating_scale_ties_prefer_more_repetitions():
     # L = 5, ~2: 2 reps give s = 1.25 (0.25 off), 3 reps s = 0.833 (0.167 off): 3 wins
-    assert [p.size for p in solve([Repeat((Piece("float", 2.0, "A"),))], 5.0)] == pytest.approx([5 / 3] * 3)
+    assert [p.size for p in solve([Repeat((Piece("float", 2.0, "A"),))], 5.0)] == pytest.approx(
+        [5 / 3] * 3
+    )
     # exact tie: L = 3 with ~2: 1 rep s = 1.5, 2 reps s = 0.75 -> |0.5| vs |0.25|; L = 2.4, ~1.6:
     # 1 rep s = 1.5 (0.5 off), 2 reps s = 0.75 (0.25 off)
     assert len(solve([Repeat((Piece("float", 1.0, "A"),))], 1.5)) == 2  # s = 1.5 vs 0.75 -> 2
@@ -70,8 +96,13 @@ def test_floating_scale_ties_prefer_more_repetitions():
 
 def test_several_repeat_groups_share_a_multiplier():
     # A { B | C }* B { D }* A: counts differ by at most one
-    items = [Piece("abs", 1, "A"), Repeat((Piece("float", 1, "B"), Piece("abs", 1, "C"))), Piece("float", 1, "B"),
-             Repeat((Piece("float", 2, "D"),)), Piece("abs", 1, "A")]
+    items = [
+        Piece("abs", 1, "A"),
+        Repeat((Piece("float", 1, "B"), Piece("abs", 1, "C"))),
+        Piece("float", 1, "B"),
+        Repeat((Piece("float", 2, "D"),)),
+        Piece("abs", 1, "A"),
+    ]
     for length in (8, 13, 21, 34):
         placed = solve(items, length)
         c_count = sum(p.payload == "C" for p in placed)
@@ -81,4 +112,6 @@ def test_several_repeat_groups_share_a_multiplier():
 
 
 def test_absolute_sizes_overflowing_leave_floats_nothing():
-    assert [(p.payload, p.size) for p in solve([Piece("abs", 12, "A"), Piece("float", 1, "B")], 10)] == [("A", 10)]
+    assert [
+        (p.payload, p.size) for p in solve([Piece("abs", 12, "A"), Piece("float", 1, "B")], 10)
+    ] == [("A", 10)]

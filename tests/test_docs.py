@@ -11,8 +11,15 @@ import pytest
 
 import bgr
 from bgr.grammar.reference import reference_markdown
-from bgr.grammar.registry import (BUILTIN_NAMES, BUILTINS, COMP_SELECTORS, OFFSET_SELECTORS, OPERATIONS,
-                                  PRIMITIVES, ROOF_KINDS)
+from bgr.grammar.registry import (
+    BUILTIN_NAMES,
+    BUILTINS,
+    COMP_SELECTORS,
+    OFFSET_SELECTORS,
+    OPERATIONS,
+    PRIMITIVES,
+    ROOF_KINDS,
+)
 
 ROOT = Path(__file__).resolve().parent.parent
 DOCS = ROOT / "docs"
@@ -88,9 +95,18 @@ def test_language_reference_mentions_builtin_function(name: str) -> None:
     assert _mentions_call(text, name), f"docs/language.md never shows the function {name}(...)"
 
 
-@pytest.mark.parametrize("word", sorted(set(BUILTIN_NAMES) | set(ROOF_KINDS) | set(PRIMITIVES)
-                                       | set(COMP_SELECTORS) | set(OFFSET_SELECTORS)))
+@pytest.mark.parametrize(
+    "word",
+    sorted(
+        set(BUILTIN_NAMES)
+        | set(ROOF_KINDS)
+        | set(PRIMITIVES)
+        | set(COMP_SELECTORS)
+        | set(OFFSET_SELECTORS)
+    ),
+)
 def test_language_reference_mentions_symbol(word: str) -> None:
     text = LANGUAGE.read_text(encoding="utf-8")
-    assert f"`{word}`" in text or re.search(rf"`[^`\n]*(?<![\w.]){re.escape(word)}(?![\w])[^`\n]*`", text), \
-        f"docs/language.md never mentions `{word}`"
+    assert f"`{word}`" in text or re.search(
+        rf"`[^`\n]*(?<![\w.]){re.escape(word)}(?![\w])[^`\n]*`", text
+    ), f"docs/language.md never mentions `{word}`"

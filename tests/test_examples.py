@@ -10,7 +10,9 @@ from bgr.interpreter.writers import read_glb
 from conftest import ROOT
 
 EXAMPLES = [
-    ("house.bgr", []), ("tower.bgr", []), ("city_block.bgr", []),
+    ("house.bgr", []),
+    ("tower.bgr", []),
+    ("city_block.bgr", []),
     ("l_building.bgr", ["--lot", str(ROOT / "examples" / "l_lot.geojson")]),
     ("house.bgr", ["--lot", str(ROOT / "examples" / "block.geojson")]),
 ]
@@ -18,13 +20,29 @@ EXAMPLES = [
 
 def derive(tmp_path, name, extra, out="out.glb"):
     target = tmp_path / out
-    proc = subprocess.run([sys.executable, "-m", "bgr", "derive", str(ROOT / "examples" / name),
-                           "--seed", "3", "-o", str(target), *extra], capture_output=True, text=True)
+    proc = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "bgr",
+            "derive",
+            str(ROOT / "examples" / name),
+            "--seed",
+            "3",
+            "-o",
+            str(target),
+            *extra,
+        ],
+        capture_output=True,
+        text=True,
+    )
     assert proc.returncode == 0, proc.stderr
     return target
 
 
-@pytest.mark.parametrize("name, extra", EXAMPLES, ids=[f"{n}{'+lot' if e else ''}" for n, e in EXAMPLES])
+@pytest.mark.parametrize(
+    "name, extra", EXAMPLES, ids=[f"{n}{'+lot' if e else ''}" for n, e in EXAMPLES]
+)
 def test_example_derives_to_a_glb_that_loads(tmp_path, name, extra):
     first = derive(tmp_path, name, extra, "a.glb")
     second = derive(tmp_path, name, extra, "b.glb")
@@ -45,7 +63,9 @@ def test_house_terminal_list_is_byte_identical_and_labelled(tmp_path):
 
 
 def test_geojson_lots_get_their_own_heights(tmp_path):
-    out = derive(tmp_path, "house.bgr", ["--lot", str(ROOT / "examples" / "block.geojson")], "block.json")
+    out = derive(
+        tmp_path, "house.bgr", ["--lot", str(ROOT / "examples" / "block.geojson")], "block.json"
+    )
     data = json.loads(out.read_text())
     tops = {}
     for t in data["terminals"]:

@@ -25,12 +25,15 @@ from hypothesis import strategies as st
 # ---- the symbolic rule ---------------------------------------------------------------------------
 
 
-@pytest.mark.parametrize("face, rule", [
-    ("ABABABA", "(AB)*A"),
-    ("AABAABAA", "A(AB)*A(AB)*AA"),
-    ("ACABABA", "AC(AB)*A"),
-    ("ABCBCBCBA", "A(BC)*BA"),  # Figure 4
-])
+@pytest.mark.parametrize(
+    "face, rule",
+    [
+        ("ABABABA", "(AB)*A"),
+        ("AABAABAA", "A(AB)*A(AB)*AA"),
+        ("ACABABA", "AC(AB)*A"),
+        ("ABCBCBCBA", "A(BC)*BA"),  # Figure 4
+    ],
+)
 def test_paper_derivations(face, rule):
     assert to_text(rewrite(list(face)), list(face)) == rule
 
@@ -55,7 +58,8 @@ def test_symbols_feed_rewrite():
 segment = st.one_of(
     st.sampled_from("ABCD").map(lambda c: c),
     st.tuples(st.sampled_from("ABCD"), st.sampled_from("ABCD"), st.integers(1, 5))
-    .filter(lambda t: t[0] != t[1]).map(lambda t: (t[0] + t[1]) * t[2]),
+    .filter(lambda t: t[0] != t[1])
+    .map(lambda t: (t[0] + t[1]) * t[2]),
 )
 faces = st.lists(segment, max_size=8).map(lambda parts: list("".join(parts)))
 
@@ -74,7 +78,9 @@ def test_rewrite_never_stars_aa_nor_adjacent_equal_stars(face):
     for left, right in itertools.pairwise(items):
         if isinstance(left, Star) and isinstance(right, Star):
             assert (face[left.first_index], face[left.second_index]) != (
-                face[right.first_index], face[right.second_index])
+                face[right.first_index],
+                face[right.second_index],
+            )
 
 
 @given(faces)
@@ -84,7 +90,11 @@ def test_rewrite_marks_exactly_the_reoccurring_pairs(face):
     for s in stars(items):
         assert occurs(face[s.first_index], face[s.second_index]) >= 2
     for left, right in itertools.pairwise(items):  # two plain columns never form a reoccurring pair
-        if isinstance(left, Sym) and isinstance(right, Sym) and face[left.index] != face[right.index]:
+        if (
+            isinstance(left, Sym)
+            and isinstance(right, Sym)
+            and face[left.index] != face[right.index]
+        ):
             assert occurs(face[left.index], face[right.index]) < 2
 
 
@@ -129,12 +139,25 @@ def via_solver(items, widths, fixed, length):
             split.append(Piece(kind(item.index), widths[item.index], ("sym", item.index)))
         else:
             g = groups.index(item)
-            split.append(Repeat((Piece(kind(item.first_index), widths[item.first_index], ("star", g, 0)),
-                                 Piece(kind(item.second_index), widths[item.second_index], ("star", g, 1)))))
+            split.append(
+                Repeat(
+                    (
+                        Piece(kind(item.first_index), widths[item.first_index], ("star", g, 0)),
+                        Piece(kind(item.second_index), widths[item.second_index], ("star", g, 1)),
+                    )
+                )
+            )
     placed = solve(split, length)
     counts = tuple(sum(p.payload == ("star", g, 0) for p in placed) for g in range(len(groups)))
-    column = lambda p: p.payload[1] if p.payload[0] == "sym" else (
-        groups[p.payload[1]].first_index if p.payload[2] == 0 else groups[p.payload[1]].second_index)
+    column = lambda p: (
+        p.payload[1]
+        if p.payload[0] == "sym"
+        else (
+            groups[p.payload[1]].first_index
+            if p.payload[2] == 0
+            else groups[p.payload[1]].second_index
+        )
+    )
     scales = [p.size / widths[column(p)] for p in placed if not fixed[column(p)]]
     assert not scales or max(scales) - min(scales) < 1e-9
     return counts, scales[0] if scales else 0.0  # pieces of no size are not placed
@@ -150,9 +173,11 @@ def is_tie(items, widths, fixed, length, a, b):
     """Two count tuples whose scales are equally close to 1, to rounding: where LANGUAGE.md's
     tie rule (more repetitions) applies, or, for equal totals, the order of the search.  The
     solver compares exact floats, so there rounding may pick either."""
+
     def distance(counts):
         fixed_width, var_width = nominal(items, widths, fixed, counts)
         return abs((length - fixed_width) / var_width - 1.0)
+
     return abs(distance(a) - distance(b)) < 1e-9
 
 
@@ -179,7 +204,9 @@ def test_retarget_agrees_with_split_solver(schema, factor):
     assume(scale > 0)  # fixed columns alone overflow: both rules are off their map
     theirs, their_scale = via_solver(items, widths, fixed, length)
     if 0 in counts:  # the paper's k = 0; LANGUAGE.md keeps one repetition (test_paper_allows_zero)
-        assert all(t <= 1 for t in theirs)  # one each (a repetition squeezed to nothing is not placed)
+        assert all(
+            t <= 1 for t in theirs
+        )  # one each (a repetition squeezed to nothing is not placed)
         return
     if counts != theirs:
         assert is_tie(items, widths, fixed, length, counts, theirs)

@@ -13,7 +13,9 @@ def test_every_shipped_grammar_is_formatted(path):
     assert format_source(text) == text, f"run: bgr fmt -w {path}"
 
 
-@pytest.mark.parametrize("path", shipped_grammars() + sorted(SHARED.glob("bench/*.bgr")), ids=lambda p: p.name)
+@pytest.mark.parametrize(
+    "path", shipped_grammars() + sorted(SHARED.glob("bench/*.bgr")), ids=lambda p: p.name
+)
 def test_round_trip_and_idempotence_on_real_grammars(path):
     text = path.read_text(encoding="utf-8")
     once = format_source(text)
@@ -22,7 +24,7 @@ def test_round_trip_and_idempotence_on_real_grammars(path):
 
 
 def test_spacing_is_canonical():
-    ugly = 'attr   a=1+2*  3\nA-->extrude( a )split(x){3:B|~1 :C}*   [t(0,0,1)B]\nB-->60 % : C|else:NIL\nC-->NIL'
+    ugly = "attr   a=1+2*  3\nA-->extrude( a )split(x){3:B|~1 :C}*   [t(0,0,1)B]\nB-->60 % : C|else:NIL\nC-->NIL"
     assert format_source(ugly) == (
         "attr a = 1 + 2 * 3\n"
         "A --> extrude(a) split(x) { 3: B | ~1: C }* [ t(0, 0, 1) B ]\n"
@@ -81,28 +83,84 @@ def test_long_rules_break_into_one_entry_per_line():
     )
 
 
-@pytest.mark.parametrize("text", [
-    "a - (b - c)", "(a - b) - c", "a / (b * c)", "(-a) ** 2", "-a ** 2", "2 ** -1", "(a or b) and c",
-    "not (a and b)", "(not a) == b", "a + (not b)", "(a ? b : c) + 1", "(a ? b : c) ? d : e",
-    "a ? b : c ? d : e", "-(a + b)", "-(-a)", "x % 2 == 0", "(2 ** 3) ** 2", "f(-1, 'x)",
-])
+@pytest.mark.parametrize(
+    "text",
+    [
+        "a - (b - c)",
+        "(a - b) - c",
+        "a / (b * c)",
+        "(-a) ** 2",
+        "-a ** 2",
+        "2 ** -1",
+        "(a or b) and c",
+        "not (a and b)",
+        "(not a) == b",
+        "a + (not b)",
+        "(a ? b : c) + 1",
+        "(a ? b : c) ? d : e",
+        "a ? b : c ? d : e",
+        "-(a + b)",
+        "-(-a)",
+        "x % 2 == 0",
+        "(2 ** 3) ** 2",
+        "f(-1, 'x)",
+    ],
+)
 def test_expressions_keep_their_meaning(text):
-    src = f"attr x = 1\nfunc f(a, b) = a\nattr a = {text}\n" if "'" not in text else f"A --> s({text[2:-1]}, 0)\n"
+    src = (
+        f"attr x = 1\nfunc f(a, b) = a\nattr a = {text}\n"
+        if "'" not in text
+        else f"A --> s({text[2:-1]}, 0)\n"
+    )
     assert parse(format_source(src)) == parse(src)
 
 
 def test_trees_built_in_code_print_and_parse_back():
     """The inverse modules build trees, not text: the formatter is how they write .bgr."""
-    tree = n.Module([
-        n.Attr("w", n.Number(-0.25)),
-        n.Rule("Facade", [], n.Sequence([n.Operation("split", [n.Name("y")], n.Block([
-            n.Entry("abs", n.Number(4), n.Sequence([n.Successor("Shop")])),
-            n.Group([n.Entry("float", n.Number(3.2), n.Sequence([n.Successor("Floor", [n.Name("split.index")])]))]),
-        ]))])),
-        n.Rule("Shop", [], n.Stochastic([n.Choice(n.Number(50), n.Sequence([n.Nil()])),
-                                         n.Choice(None, n.Sequence([n.Successor("Floor", [n.Number(0)])]))])),
-        n.Rule("Floor", ["i"], n.Sequence([n.Operation("color", [n.String("#aabbcc")])])),
-    ])
+    tree = n.Module(
+        [
+            n.Attr("w", n.Number(-0.25)),
+            n.Rule(
+                "Facade",
+                [],
+                n.Sequence(
+                    [
+                        n.Operation(
+                            "split",
+                            [n.Name("y")],
+                            n.Block(
+                                [
+                                    n.Entry("abs", n.Number(4), n.Sequence([n.Successor("Shop")])),
+                                    n.Group(
+                                        [
+                                            n.Entry(
+                                                "float",
+                                                n.Number(3.2),
+                                                n.Sequence(
+                                                    [n.Successor("Floor", [n.Name("split.index")])]
+                                                ),
+                                            )
+                                        ]
+                                    ),
+                                ]
+                            ),
+                        )
+                    ]
+                ),
+            ),
+            n.Rule(
+                "Shop",
+                [],
+                n.Stochastic(
+                    [
+                        n.Choice(n.Number(50), n.Sequence([n.Nil()])),
+                        n.Choice(None, n.Sequence([n.Successor("Floor", [n.Number(0)])])),
+                    ]
+                ),
+            ),
+            n.Rule("Floor", ["i"], n.Sequence([n.Operation("color", [n.String("#aabbcc")])])),
+        ]
+    )
     text = format_module(tree)
     assert text == (
         "attr w = -0.25\n"

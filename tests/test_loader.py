@@ -16,10 +16,17 @@ def test_load_a_path_text_or_bytes(tmp_path):
 
 
 def test_grammar_exposes_its_declarations():
-    g = bgr.load('version 1\nattr h = 3\nconst c = 2\nfunc f(x) = x * c\nasset col = "c.glb"\n'
-                 "start B\nA --> NIL\nB --> A\n")
+    g = bgr.load(
+        'version 1\nattr h = 3\nconst c = 2\nfunc f(x) = x * c\nasset col = "c.glb"\n'
+        "start B\nA --> NIL\nB --> A\n"
+    )
     assert (g.version, g.start) == (1, "B")
-    assert set(g.attrs) == {"h"} and set(g.consts) == {"c"} and set(g.funcs) == {"f"} and set(g.assets) == {"col"}
+    assert (
+        set(g.attrs) == {"h"}
+        and set(g.consts) == {"c"}
+        and set(g.funcs) == {"f"}
+        and set(g.assets) == {"col"}
+    )
 
 
 def test_without_start_the_first_rule_is_the_axiom():
@@ -28,7 +35,9 @@ def test_without_start_the_first_rule_is_the_axiom():
 
 def test_relative_imports_resolve_from_the_importing_file(tmp_path):
     (tmp_path / "lib").mkdir()
-    (tmp_path / "lib" / "win.bgr").write_text('import "../parts.bgr" as parts\nWindow --> parts.Glass\n')
+    (tmp_path / "lib" / "win.bgr").write_text(
+        'import "../parts.bgr" as parts\nWindow --> parts.Glass\n'
+    )
     (tmp_path / "parts.bgr").write_text("attr inset = 0.2\nGlass --> t(0, 0, -inset) NIL\n")
     main = tmp_path / "main.bgr"
     main.write_text('import "lib/win.bgr" as win\nLot --> split(x) { ~2: win.Window }*\n')

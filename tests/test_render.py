@@ -33,6 +33,7 @@ HOUSE = ROOT / "examples" / "house.bgr"
 
 # --- helpers ------------------------------------------------------------------------------------
 
+
 def gl_or_skip():
     """Skip a GL test only when a context truly cannot be made, saying why."""
     try:
@@ -55,11 +56,14 @@ def reference_projection(points, yaw, pitch, roll, position, fov, principal, siz
     """The paper's camera written out afresh: x_cam = Rx(pitch) Ry(yaw) Rz(roll) F (X - C), with F
     the half turn about y that makes bgr's front (facing -z) face the camera; f = W / 2 tan(fov/2);
     the principal point in normalised image coordinates."""
+
     def r(axis, deg):
         c, s = math.cos(math.radians(deg)), math.sin(math.radians(deg))
-        return {"x": np.array([[1, 0, 0], [0, c, -s], [0, s, c]]),
-                "y": np.array([[c, 0, s], [0, 1, 0], [-s, 0, c]]),
-                "z": np.array([[c, -s, 0], [s, c, 0], [0, 0, 1]])}[axis]
+        return {
+            "x": np.array([[1, 0, 0], [0, c, -s], [0, s, c]]),
+            "y": np.array([[c, 0, s], [0, 1, 0], [-s, 0, c]]),
+            "z": np.array([[c, -s, 0], [s, c, 0], [0, 0, 1]]),
+        }[axis]
 
     R = r("x", pitch) @ r("y", yaw) @ r("z", roll) @ np.diag([-1.0, 1.0, -1.0])
     cam = (np.asarray(points, float) - position) @ R.T
@@ -91,12 +95,27 @@ def house():
 
 # --- camera -------------------------------------------------------------------------------------
 
+
 def test_projection_matches_the_paper_model():
     pts = np.random.default_rng(1).uniform(-5, 5, (50, 3))
-    args = {"yaw": 30, "pitch": 15, "roll": -5, "position": np.array([20.0, 12.0, -40.0]), "fov": 50,
-            "principal": (0.1, -0.2), "size": (640, 480)}
-    cam = Camera.from_angles(args["yaw"], args["pitch"], args["roll"], args["position"], args["fov"],
-                             args["principal"], args["size"])
+    args = {
+        "yaw": 30,
+        "pitch": 15,
+        "roll": -5,
+        "position": np.array([20.0, 12.0, -40.0]),
+        "fov": 50,
+        "principal": (0.1, -0.2),
+        "size": (640, 480),
+    }
+    cam = Camera.from_angles(
+        args["yaw"],
+        args["pitch"],
+        args["roll"],
+        args["position"],
+        args["fov"],
+        args["principal"],
+        args["size"],
+    )
     pixels, depth = cam.project(pts)
     assert np.allclose(pixels, reference_projection(pts, **args))
     assert (depth > 0).all()
@@ -130,19 +149,25 @@ def test_presets_frame_the_whole_model(house, view):
     assert span[0] > 0.8 * 400 or span[1] > 0.8 * 300  # and fills it
 
 
-@pytest.mark.parametrize("content, words", [
-    ("{", "not valid JSON"),
-    ("[1, 2]", "one JSON object"),
-    ('{"position": [0, 0, -10], "fvo": 40}', "unknown camera key 'fvo'"),
-    ('{"fov": 40}', "needs 'position'"),
-    ('{"position": [0, 0], "fov": 40}', "'position' must be a list of 3 numbers"),
-    ('{"position": [0, 0, -9], "fov": "wide"}', "'fov' must be a number"),
-    ('{"position": [0, 0, -9], "fov": 200}', "'fov' must be between 0 and 180"),
-    ('{"position": [0, 0, -9], "rotation": [[1, 0, 0], [0, 2, 0], [0, 0, 1]]}', "'rotation' is not a rotation"),
-    ('{"position": [0, 0, -9], "yaw": 10, "target": [0, 0, 0]}', "give one way of turning it"),
-    ('{"position": [0, 0, -9], "size": [0, 10]}', "'size' must be two positive whole numbers"),
-    ('{"position": [0, 0, -9], "target": [0, 0, -9]}', "'target'"),
-])
+@pytest.mark.parametrize(
+    "content, words",
+    [
+        ("{", "not valid JSON"),
+        ("[1, 2]", "one JSON object"),
+        ('{"position": [0, 0, -10], "fvo": 40}', "unknown camera key 'fvo'"),
+        ('{"fov": 40}', "needs 'position'"),
+        ('{"position": [0, 0], "fov": 40}', "'position' must be a list of 3 numbers"),
+        ('{"position": [0, 0, -9], "fov": "wide"}', "'fov' must be a number"),
+        ('{"position": [0, 0, -9], "fov": 200}', "'fov' must be between 0 and 180"),
+        (
+            '{"position": [0, 0, -9], "rotation": [[1, 0, 0], [0, 2, 0], [0, 0, 1]]}',
+            "'rotation' is not a rotation",
+        ),
+        ('{"position": [0, 0, -9], "yaw": 10, "target": [0, 0, 0]}', "give one way of turning it"),
+        ('{"position": [0, 0, -9], "size": [0, 10]}', "'size' must be two positive whole numbers"),
+        ('{"position": [0, 0, -9], "target": [0, 0, -9]}', "'target'"),
+    ],
+)
 def test_camera_file_errors_name_the_problem(tmp_path, content, words):
     path = tmp_path / "cam.json"
     path.write_text(content)
@@ -153,8 +178,10 @@ def test_camera_file_errors_name_the_problem(tmp_path, content, words):
 
 def test_camera_file_forms(tmp_path):
     path = tmp_path / "cam.json"
-    path.write_text('{"fov": 50, "position": [4, 3, -20], "yaw": 20, "pitch": 10, "principal_point": [0.1, 0], '
-                    '"size": [320, 200]}')
+    path.write_text(
+        '{"fov": 50, "position": [4, 3, -20], "yaw": 20, "pitch": 10, "principal_point": [0.1, 0], '
+        '"size": [320, 200]}'
+    )
     cam = Camera.from_json(path)
     assert cam.size == (320, 200) and cam.principal_point == (0.1, 0.0)
     ref = Camera.from_angles(20, 10, 0, [4, 3, -20], 50, (0.1, 0.0), (320, 200))
@@ -171,15 +198,32 @@ def test_camera_file_forms(tmp_path):
 
 # --- rasterisers --------------------------------------------------------------------------------
 
+
 @pytest.mark.parametrize("backend", BACKENDS)
 def test_box_silhouette_matches_the_projected_hull(backend):
     lo, hi = np.array([1.0, 0.0, 2.0]), np.array([9.0, 5.0, 8.0])
     scene = box_scene(lo, hi)
-    args = {"yaw": 25, "pitch": 20, "roll": 4, "position": np.array([18.0, 14.0, -16.0]), "fov": 45,
-            "principal": (0.05, -0.1), "size": (400, 300)}
-    cam = Camera.from_angles(args["yaw"], args["pitch"], args["roll"], args["position"], args["fov"],
-                             args["principal"], args["size"])
-    corners = np.array([[x, y, z] for x in (lo[0], hi[0]) for y in (lo[1], hi[1]) for z in (lo[2], hi[2])])
+    args = {
+        "yaw": 25,
+        "pitch": 20,
+        "roll": 4,
+        "position": np.array([18.0, 14.0, -16.0]),
+        "fov": 45,
+        "principal": (0.05, -0.1),
+        "size": (400, 300),
+    }
+    cam = Camera.from_angles(
+        args["yaw"],
+        args["pitch"],
+        args["roll"],
+        args["position"],
+        args["fov"],
+        args["principal"],
+        args["size"],
+    )
+    corners = np.array(
+        [[x, y, z] for x in (lo[0], hi[0]) for y in (lo[1], hi[1]) for z in (lo[2], hi[2])]
+    )
     hull = shapely.MultiPoint(reference_projection(corners, **args)).convex_hull
     expected = mask_of_polygon(hull, args["size"])
     got = frame_of(scene, cam, backend).mask
@@ -196,11 +240,20 @@ def grid_square(n, jitter, rng):
     shift[:, [0, -1], :] = 0.0
     shift[:, :, [0, -1]] = 0.0
     verts = np.stack([xs + shift[0], ys + shift[1], np.zeros_like(xs)], axis=-1).reshape(-1, 3)
-    quads = [(i * n + j, i * n + j + 1, (i + 1) * n + j + 1, (i + 1) * n + j)
-             for i in range(n - 1) for j in range(n - 1)]
+    quads = [
+        (i * n + j, i * n + j + 1, (i + 1) * n + j + 1, (i + 1) * n + j)
+        for i in range(n - 1)
+        for j in range(n - 1)
+    ]
     faces = np.array([(a, b, c) for a, b, c, _ in quads] + [(a, c, d) for a, _, c, d in quads])
     k = len(faces)
-    return Scene(verts[faces], np.full((k, 3), 200, np.uint8), np.zeros(k, np.int64), np.zeros(k, np.int64), ["x"])
+    return Scene(
+        verts[faces],
+        np.full((k, 3), 200, np.uint8),
+        np.zeros(k, np.int64),
+        np.zeros(k, np.int64),
+        ["x"],
+    )
 
 
 @pytest.mark.parametrize("backend", BACKENDS)
@@ -216,7 +269,9 @@ def test_adjacent_triangles_leave_no_holes(backend):
     exact = Camera.from_angles(0, 0, 0, [5, 5, -distance], fov, size=(257, 257))
     cases = [(grid_square(33, 0.0, rng), exact), (grid_square(33, 0.12, rng), exact)]
     for yaw in (160.0, 23.0, -40.0):
-        eye = np.array([5, 5, 0]) - 20 * np.array([math.sin(math.radians(yaw)), -0.2, math.cos(math.radians(yaw))])
+        eye = np.array([5, 5, 0]) - 20 * np.array(
+            [math.sin(math.radians(yaw)), -0.2, math.cos(math.radians(yaw))]
+        )
         cases.append((grid_square(33, 0.12, rng), Camera.look_at(eye, [5, 5, 0], size=(256, 256))))
     for k, (fine, cam) in enumerate(cases):
         a, b = frame_of(fine, cam, backend).mask, frame_of(coarse, cam, backend).mask
@@ -225,7 +280,9 @@ def test_adjacent_triangles_leave_no_holes(backend):
             assert (a == b).all(), (k, (a != b).sum())
         else:  # in perspective the outline's inner corners snap to 1/256 px off the straight edge
             inner = b.copy()
-            inner[1:-1, 1:-1] = b[1:-1, 1:-1] & b[:-2, 1:-1] & b[2:, 1:-1] & b[1:-1, :-2] & b[1:-1, 2:]
+            inner[1:-1, 1:-1] = (
+                b[1:-1, 1:-1] & b[:-2, 1:-1] & b[2:, 1:-1] & b[1:-1, :-2] & b[1:-1, 2:]
+            )
             assert a[inner].all(), (k, (inner & ~a).sum())  # no hole inside
             assert (a != b).sum() <= 4, (k, (a != b).sum())
 
@@ -282,12 +339,19 @@ def test_forked_child_falls_back_instead_of_hanging():
         "_, status = os.waitpid(pid, 0)\n"
         "raise SystemExit(os.waitstatus_to_exitcode(status))\n"
     )
-    proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120,
-                          env={**os.environ, "HOUSE": str(HOUSE)}, check=False)
+    proc = subprocess.run(
+        [sys.executable, "-c", code],
+        capture_output=True,
+        text=True,
+        timeout=120,
+        env={**os.environ, "HOUSE": str(HOUSE)},
+        check=False,
+    )
     assert proc.returncode == 0, proc.stderr
 
 
 # --- images -------------------------------------------------------------------------------------
+
 
 @pytest.mark.parametrize("view", ["front", "iso", "top"])
 def test_shaded_house_is_not_blank(house, view):
@@ -302,16 +366,24 @@ def test_shaded_house_is_not_blank(house, view):
 
 def test_labels_give_one_colour_per_label(house):
     image, legend = render_labels(house, "iso", size=(320, 240), backend="numpy")
-    assert set(legend["labels"]) == set(house.labels) == {"Door", "Frame", "Glass", "Roof", "Sill", "Wall"}
+    assert (
+        set(legend["labels"])
+        == set(house.labels)
+        == {"Door", "Frame", "Glass", "Roof", "Sill", "Wall"}
+    )
     colours = list(legend["labels"].values())
     assert len(set(colours)) == len(colours) and "#000000" not in colours
     frame = rasterise(house, Camera.preset("iso", *house.bounds(), size=(320, 240)), "numpy")
-    label_at = np.array(house.labels + ["(background)"])[np.concatenate([house.label, [-1]])[frame.triangle]]
+    label_at = np.array(house.labels + ["(background)"])[
+        np.concatenate([house.label, [-1]])[frame.triangle]
+    ]
     hexes = np.array([images.hex_colour(p) for p in image.reshape(-1, 3)]).reshape(240, 320)
     for name in np.unique(label_at):
         seen = set(hexes[label_at == name])
         assert seen == {legend["labels"].get(name, "#000000")}, name
-    assert images.label_colours(["Wall"])["Wall"] == images.label_colours(house.labels)["Wall"]  # fixed colours
+    assert (
+        images.label_colours(["Wall"])["Wall"] == images.label_colours(house.labels)["Wall"]
+    )  # fixed colours
 
 
 def test_lines_draw_the_box_outline_but_no_face_diagonal():
@@ -323,8 +395,12 @@ def test_lines_draw_the_box_outline_but_no_face_diagonal():
     assert line.mean() < 0.05
     pixels, _ = cam.project(np.array([[x, y, z] for x in (0, 8) for y in (0, 5) for z in (0, 6)]))
     hull = shapely.MultiPoint(pixels).convex_hull
-    near_line = np.zeros_like(line)  # lines grown by one pixel: the outline may sit half a pixel off
-    near_line[1:-1, 1:-1] = line[1:-1, 1:-1] | line[:-2, 1:-1] | line[2:, 1:-1] | line[1:-1, :-2] | line[1:-1, 2:]
+    near_line = np.zeros_like(
+        line
+    )  # lines grown by one pixel: the outline may sit half a pixel off
+    near_line[1:-1, 1:-1] = (
+        line[1:-1, 1:-1] | line[:-2, 1:-1] | line[2:, 1:-1] | line[1:-1, :-2] | line[1:-1, 2:]
+    )
     outline = hull.exterior
     for t in np.linspace(0, 1, 200, endpoint=False):
         x, y = outline.interpolate(t, normalized=True).coords[0]
@@ -343,7 +419,7 @@ def test_lines_draw_the_box_outline_but_no_face_diagonal():
             # the diagonal is the edge shared by the face's two triangles
             shared = [p for p in tri[on[0]] if any(np.allclose(p, q) for q in tri[on[1]])]
             for t in np.linspace(0.3, 0.7, 9):
-                (u, v), = cam.project([shared[0] + t * (shared[1] - shared[0])])[0]
+                ((u, v),) = cam.project([shared[0] + t * (shared[1] - shared[0])])[0]
                 assert not line[int(v), int(u)], (axis, side, t)
             checked += 1
     assert checked == 3
@@ -368,6 +444,7 @@ def test_glb_scene_labels_by_material(tmp_path):
 
 # --- files and the command line ----------------------------------------------------------------
 
+
 def test_save_png_is_atomic(tmp_path):
     image = np.zeros((10, 20, 3), np.uint8)
     with pytest.raises(bgr.BgrError, match="does not exist"):
@@ -383,14 +460,49 @@ def test_save_png_is_atomic(tmp_path):
 
 def test_cli_writes_pngs(tmp_path, capsys):
     out = tmp_path / "p.png"
-    assert main(["render", str(HOUSE), "-o", str(out), "--size", "160x120", "--seed", "3",
-                 "--set", "height=14", "--lot", "24,16"]) == 0
+    assert (
+        main(
+            [
+                "render",
+                str(HOUSE),
+                "-o",
+                str(out),
+                "--size",
+                "160x120",
+                "--seed",
+                "3",
+                "--set",
+                "height=14",
+                "--lot",
+                "24,16",
+            ]
+        )
+        == 0
+    )
     with Image.open(out) as im:
         assert im.format == "PNG" and im.size == (160, 120) and im.mode == "RGB"
     assert "160x120 shaded" in capsys.readouterr().err
     out2 = tmp_path / "l.png"
-    assert main(["render", str(HOUSE), "-o", str(out2), "--size", "160x120", "--mode", "labels", "--legend",
-                 "--view", "front", "--backend", "numpy"]) == 0
+    assert (
+        main(
+            [
+                "render",
+                str(HOUSE),
+                "-o",
+                str(out2),
+                "--size",
+                "160x120",
+                "--mode",
+                "labels",
+                "--legend",
+                "--view",
+                "front",
+                "--backend",
+                "numpy",
+            ]
+        )
+        == 0
+    )
     legend = json.loads((tmp_path / "l.legend.json").read_text())
     assert legend["background"] == "#000000" and "Wall" in legend["labels"]
     cam = tmp_path / "cam.json"
@@ -418,14 +530,17 @@ def test_cli_failures_leave_no_file(tmp_path, capsys):
     assert sorted(p.name for p in tmp_path.iterdir()) == ["cam.json", "div.bgr"]
 
 
-@pytest.mark.parametrize("args", [
-    [],  # no -o
-    ["-o", "x.png", "--size", "big"],
-    ["-o", "x.png", "--view", "side"],
-    ["-o", "x.png", "--mode", "wire"],
-    ["-o", "x.png", "--legend"],
-    ["-o", "x.png", "--set", "novalue"],
-])
+@pytest.mark.parametrize(
+    "args",
+    [
+        [],  # no -o
+        ["-o", "x.png", "--size", "big"],
+        ["-o", "x.png", "--view", "side"],
+        ["-o", "x.png", "--mode", "wire"],
+        ["-o", "x.png", "--legend"],
+        ["-o", "x.png", "--set", "novalue"],
+    ],
+)
 def test_cli_usage_errors(args, capsys):
     with pytest.raises(SystemExit) as info:
         raise SystemExit(main(["render", str(HOUSE), *args]))
@@ -441,8 +556,12 @@ def test_cli_model_options_only_for_grammars(tmp_path):
 
 def test_cli_subprocess_no_traceback(tmp_path):
     out = tmp_path / "p.png"
-    proc = subprocess.run([sys.executable, "-m", "bgr", "render", str(tmp_path / "nope.bgr"), "-o", str(out)],
-                          capture_output=True, text=True, check=False)
+    proc = subprocess.run(
+        [sys.executable, "-m", "bgr", "render", str(tmp_path / "nope.bgr"), "-o", str(out)],
+        capture_output=True,
+        text=True,
+        check=False,
+    )
     assert proc.returncode == 1 and "Traceback" not in proc.stderr and "no such file" in proc.stderr
     assert not out.exists()
 
@@ -452,6 +571,21 @@ def test_same_inputs_same_bytes(tmp_path, backend):
     if backend == "gl":
         gl_or_skip()
     for name in ("a.png", "b.png"):
-        assert main(["render", str(HOUSE), "-o", str(tmp_path / name), "--size", "200x150", "--seed", "3",
-                     "--backend", backend]) == 0
+        assert (
+            main(
+                [
+                    "render",
+                    str(HOUSE),
+                    "-o",
+                    str(tmp_path / name),
+                    "--size",
+                    "200x150",
+                    "--seed",
+                    "3",
+                    "--backend",
+                    backend,
+                ]
+            )
+            == 0
+        )
     assert (tmp_path / "a.png").read_bytes() == (tmp_path / "b.png").read_bytes()

@@ -18,8 +18,13 @@ import shapely
 from shapely.geometry import LineString, Polygon
 
 from bgr.interpreter.geometry.earclip import triangulate
-from bgr.interpreter.geometry.roofs import (KINDS, MANSARD_BREAK, RoofMesh, mansard_lower_pitch,
-                                            roof_mesh)
+from bgr.interpreter.geometry.roofs import (
+    KINDS,
+    MANSARD_BREAK,
+    RoofMesh,
+    mansard_lower_pitch,
+    roof_mesh,
+)
 from bgr.interpreter.geometry.skeleton import offset_outward, straight_skeleton
 
 trimesh = pytest.importorskip("trimesh")
@@ -51,13 +56,15 @@ def edge_frame(poly: np.ndarray, i: int):
 def capped(mesh: RoofMesh) -> "trimesh.Trimesh":
     """The roof closed with a downward cap on its eave outline."""
     cap = triangulate(mesh.eave[:, :2])[:, ::-1] + len(mesh.vertices)
-    return trimesh.Trimesh(np.vstack([mesh.vertices, mesh.eave]), np.vstack([mesh.faces, cap]),
-                           process=True)
+    return trimesh.Trimesh(
+        np.vstack([mesh.vertices, mesh.eave]), np.vstack([mesh.faces, cap]), process=True
+    )
 
 
 def boundary_edges(mesh: RoofMesh) -> list[tuple[int, int]]:
-    count = Counter(tuple(sorted((int(f[i]), int(f[(i + 1) % 3]))))
-                    for f in mesh.faces for i in range(3))
+    count = Counter(
+        tuple(sorted((int(f[i]), int(f[(i + 1) % 3])))) for f in mesh.faces for i in range(3)
+    )
     return [e for e, n in count.items() if n == 1]
 
 
@@ -196,8 +203,9 @@ def test_overhang_extends_the_eaves(name):
     for i in range(len(mesh.eave)):
         a, b = mesh.eave[i, :2], mesh.eave[(i + 1) % len(mesh.eave), :2]
         mid = (a + b) / 2
-        assert LineString(poly.tolist() + [poly[0].tolist()]).distance(shapely.Point(mid)) == \
-            pytest.approx(over, abs=TOL)
+        assert LineString(poly.tolist() + [poly[0].tolist()]).distance(
+            shapely.Point(mid)
+        ) == pytest.approx(over, abs=TOL)
     tiles = [Polygon(mesh.vertices[f, :2]) for f in mesh.faces[sloped(mesh)]]
     assert sum(t.area for t in tiles) == pytest.approx(grown.area, abs=TOL)
 
@@ -257,8 +265,9 @@ def test_pyramid_apex():
     mesh = roof_mesh(footprint("L"), "pyramid", PITCH)
     assert mesh.kind == "pyramid" and len(mesh.faces) == 6
     apex = mesh.vertices[np.argmax(mesh.vertices[:, 2])]
-    assert Polygon(footprint("L")).exterior.distance(shapely.Point(apex[:2])) * TAN == \
-        pytest.approx(apex[2])
+    assert Polygon(footprint("L")).exterior.distance(
+        shapely.Point(apex[:2])
+    ) * TAN == pytest.approx(apex[2])
     # a U has no point that sees all its edges: it gets a hip roof
     assert roof_mesh(footprint("U"), "pyramid", PITCH).kind == "hip"
 
@@ -329,15 +338,18 @@ def test_collinear_and_repeated_points_are_merged():
     assert front.edges == (0, 1, 6) and front.edge in (0, 1)  # 6 is the closing repeat
 
 
-@pytest.mark.parametrize("args, message", [
-    (([(0, 0), (1, 0), (1, 1)], "dome", 30), "unknown roof kind"),
-    (([(0, 0), (1, 0), (1, 1)], "hip", 0), "pitch"),
-    (([(0, 0), (1, 0), (1, 1)], "hip", 90), "pitch"),
-    (([(0, 0), (1, 0), (1, 1)], "hip", 30, -1), "overhang"),
-    (([(0, 0), (2, 2), (2, 0), (0, 2)], "hip", 30), "simple polygon"),
-    (([(0, 0), (1, 0)], "hip", 30), "K >= 3"),
-    (([(0, 0), (1, 0), (2, 0)], "flat", 0), "simple polygon"),
-])
+@pytest.mark.parametrize(
+    "args, message",
+    [
+        (([(0, 0), (1, 0), (1, 1)], "dome", 30), "unknown roof kind"),
+        (([(0, 0), (1, 0), (1, 1)], "hip", 0), "pitch"),
+        (([(0, 0), (1, 0), (1, 1)], "hip", 90), "pitch"),
+        (([(0, 0), (1, 0), (1, 1)], "hip", 30, -1), "overhang"),
+        (([(0, 0), (2, 2), (2, 0), (0, 2)], "hip", 30), "simple polygon"),
+        (([(0, 0), (1, 0)], "hip", 30), "K >= 3"),
+        (([(0, 0), (1, 0), (2, 0)], "flat", 0), "simple polygon"),
+    ],
+)
 def test_bad_arguments(args, message):
     with pytest.raises(ValueError, match=message):
         roof_mesh(*args)
@@ -367,8 +379,20 @@ def skeleton_checks(poly: np.ndarray, weights=None):
 
 def test_skeleton_of_degenerate_rectilinear_shapes():
     shapes = [
-        [(3, 0), (6, 0), (6, 3), (9, 3), (9, 6), (6, 6), (6, 9), (3, 9), (3, 6), (0, 6), (0, 3),
-         (3, 3)],  # a plus
+        [
+            (3, 0),
+            (6, 0),
+            (6, 3),
+            (9, 3),
+            (9, 6),
+            (6, 6),
+            (6, 9),
+            (3, 9),
+            (3, 6),
+            (0, 6),
+            (0, 3),
+            (3, 3),
+        ],  # a plus
         [(2, 0), (4, 0), (4, 2), (6, 2), (6, 4), (0, 4), (0, 2), (2, 2)],  # every event at once
         [(0, 0), (2, 0), (2, 2), (4, 2), (4, 0), (6, 0), (6, 4), (0, 4)],  # an upside-down U
         [(0, 0), (10, 0), (10, 1), (6, 1), (6, 3), (4, 3), (4, 1), (0, 1)],  # a bump on a bar

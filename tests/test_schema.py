@@ -47,8 +47,16 @@ def lot_of(model, tmp_path: Path):
     if len(block.footprint) == 4:
         return (block.width, block.depth)
     ring = [[x, -z] for x, z in block.footprint]
-    geo = {"type": "FeatureCollection", "features": [{"type": "Feature", "properties": {},
-           "geometry": {"type": "Polygon", "coordinates": [ring + [ring[0]]]}}]}
+    geo = {
+        "type": "FeatureCollection",
+        "features": [
+            {
+                "type": "Feature",
+                "properties": {},
+                "geometry": {"type": "Polygon", "coordinates": [ring + [ring[0]]]},
+            }
+        ],
+    }
     path = tmp_path / "lot.geojson"
     path.write_text(json.dumps(geo))
     return str(path)
@@ -65,6 +73,7 @@ def by_face(terms: list[dict]) -> dict:
 
 
 # ---- round trips -----------------------------------------------------------------------------
+
 
 def test_there_are_at_least_ten_varied_sources():
     assert len(SOURCES) >= 10
@@ -87,7 +96,9 @@ def test_round_trip_at_the_source_size(path, tmp_path):
         assert set(fa) == set(fb)
         for key in fa:
             assert [t["label"] for t in fa[key]] == [t["label"] for t in fb[key]]
-            np.testing.assert_allclose([t["size"] for t in fa[key]], [t["size"] for t in fb[key]], atol=1e-6)
+            np.testing.assert_allclose(
+                [t["size"] for t in fa[key]], [t["size"] for t in fb[key]], atol=1e-6
+            )
 
 
 def test_inferred_grammar_is_canonical_and_checks():
@@ -120,7 +131,9 @@ def _front_columns(model):
     return face.root.parts
 
 
-@pytest.mark.parametrize("src, pattern", [(PIERS, "A(BC)*BA"), (PAIRS, "A(AB)*A(AB)*AA")], ids=["piers", "pairs"])
+@pytest.mark.parametrize(
+    "src, pattern", [(PIERS, "A(BC)*BA"), (PAIRS, "A(AB)*A(AB)*AA")], ids=["piers", "pairs"]
+)
 @pytest.mark.parametrize("factor", [1.5, 0.7, 2.3])
 def test_retargeting_follows_the_papers_application_rule(src, pattern, factor):
     """The inferred schema on a face `factor` times as wide repeats each group and scales the
@@ -134,17 +147,21 @@ def test_retargeting_follows_the_papers_application_rule(src, pattern, factor):
     assert fs.to_text(items, symbols) == pattern
     width = sum(c.size for c in columns)
     # the paper's rule with LANGUAGE.md's floor of one repetition per group (docs/inverse-schema.md)
-    counts, scale = fs.retarget(items, [c.size for c in columns], [c.fixed for c in columns], width * factor,
-                                minimum=1)
+    counts, scale = fs.retarget(
+        items, [c.size for c in columns], [c.fixed for c in columns], width * factor, minimum=1
+    )
 
     grammar = style(result)
     target = terminals(bgr.derive(grammar, lot=(width * factor, 10)))
     front = [t for t in target if "FrontFacade" in t["path"]]
     assert sum(t["label"] == "Window" for t in front) == sum(
-        c for c, st in zip(counts, fs.stars(items)) if "Window" in (columns[st.first_index].label,
-                                                                   columns[st.second_index].label)) + sum(
-        1 for it in items if isinstance(it, fs.Sym) and columns[it.index].label == "Window")
-    stretched = [(t["size"][0], c) for t, c in zip(front, _expanded(items, counts, columns)) if not c.fixed]
+        c
+        for c, st in zip(counts, fs.stars(items))
+        if "Window" in (columns[st.first_index].label, columns[st.second_index].label)
+    ) + sum(1 for it in items if isinstance(it, fs.Sym) and columns[it.index].label == "Window")
+    stretched = [
+        (t["size"][0], c) for t, c in zip(front, _expanded(items, counts, columns)) if not c.fixed
+    ]
     for got, column in stretched:
         assert got == pytest.approx(column.size * scale, abs=1e-6)
     assert sum(t["size"][0] for t in front) == pytest.approx(width * factor, abs=1e-6)
@@ -165,21 +182,34 @@ def test_a_box_schema_styles_every_face_of_an_l_and_a_u(ring, tmp_path):
     src = source(DATA / "shopfront.bgr")
     model = read_model(src)
     assert {f.category for f in model.faces()} == {("outer", "outer")}
-    geo = {"type": "FeatureCollection", "features": [{"type": "Feature", "properties": {},
-           "geometry": {"type": "Polygon", "coordinates": [ring + [ring[0]]]}}]}
+    geo = {
+        "type": "FeatureCollection",
+        "features": [
+            {
+                "type": "Feature",
+                "properties": {},
+                "geometry": {"type": "Polygon", "coordinates": [ring + [ring[0]]]},
+            }
+        ],
+    }
     lot = tmp_path / "lot.geojson"
     lot.write_text(json.dumps(geo))
     out = terminals(bgr.derive(style(src), lot=str(lot)))
     faces = by_face(out)
     vertical = {k: v for k, v in faces.items() if abs(k[0][1]) < 0.5}
-    planes = {(a[0] == b[0], a[0] if a[0] == b[0] else a[1]) for a, b in zip(ring, ring[1:] + ring[:1])}
-    assert len(vertical) == len(planes)  # every side face got terminals (coplanar faces share a key)
+    planes = {
+        (a[0] == b[0], a[0] if a[0] == b[0] else a[1]) for a, b in zip(ring, ring[1:] + ring[:1])
+    }
+    assert len(vertical) == len(
+        planes
+    )  # every side face got terminals (coplanar faces share a key)
     for key, terms in vertical.items():
         labels = Counter(t["label"] for t in terms)
         assert len(labels) >= 2, f"face {key} is not styled: {labels}"
 
 
 # ---- command line ------------------------------------------------------------------------------
+
 
 def test_cli_writes_a_grammar_that_derives(tmp_path, capsys):
     src = DATA / "palazzo.bgr"
@@ -205,14 +235,22 @@ def test_cli_fixed_and_stretch_change_the_schema(tmp_path, capsys):
     assert main(["infer", str(src), "--fixed", "Wall", "--stretch", "Wall"]) == 2
 
 
-@pytest.mark.parametrize("content, message", [
-    ("{", "not valid JSON"),
-    ('{"x": 1}', "neither a terminal list nor a captured model"),
-    ('{"terminals": [{"label": "A"}]}', "terminals[0].path"),
-    ('{"terminals": []}', "empty"),
-    (('{"terminals": [{"label": "A", "path": "Lot", "origin": [0, 0, 0], '
-      '"axes": [[1, 0, 0], [0, 1, 0], [0, 0, 1]], "size": [1, 1, "x"]}]}'), "terminals[0].size"),
-])
+@pytest.mark.parametrize(
+    "content, message",
+    [
+        ("{", "not valid JSON"),
+        ('{"x": 1}', "neither a terminal list nor a captured model"),
+        ('{"terminals": [{"label": "A"}]}', "terminals[0].path"),
+        ('{"terminals": []}', "empty"),
+        (
+            (
+                '{"terminals": [{"label": "A", "path": "Lot", "origin": [0, 0, 0], '
+                '"axes": [[1, 0, 0], [0, 1, 0], [0, 0, 1]], "size": [1, 1, "x"]}]}'
+            ),
+            "terminals[0].size",
+        ),
+    ],
+)
 def test_cli_bad_inputs_exit_1_with_the_element_named(tmp_path, capsys, content, message):
     bad = tmp_path / "bad.json"
     bad.write_text(content)
@@ -231,9 +269,13 @@ def test_cli_other_kinds_say_they_are_not_written(capsys):
 # ---- fuzz: no input gives a traceback ----------------------------------------------------------
 
 
-_JSON = st.recursive(st.none() | st.booleans() | st.floats(allow_nan=True) | st.integers() | st.text(max_size=5),
-                     lambda inner: st.lists(inner, max_size=4) | st.dictionaries(st.text(max_size=8), inner, max_size=4),
-                     max_leaves=20)
+_JSON = st.recursive(
+    st.none() | st.booleans() | st.floats(allow_nan=True) | st.integers() | st.text(max_size=5),
+    lambda inner: (
+        st.lists(inner, max_size=4) | st.dictionaries(st.text(max_size=8), inner, max_size=4)
+    ),
+    max_leaves=20,
+)
 
 
 def _only_bgr_errors(data) -> None:
@@ -250,8 +292,13 @@ def test_fuzz_random_json_raises_only_bgr_errors(data):
     _only_bgr_errors(data if isinstance(data, dict) else {"terminals": data})
 
 
-_SMALL = terminals(bgr.derive(bgr.load(
-    "terminal W, N\nLot --> s(6, 0, 4) extrude(3) comp(f) { side: split(x) { ~1: W | 1: N | ~1: W }* | all: NIL }\n")))
+_SMALL = terminals(
+    bgr.derive(
+        bgr.load(
+            "terminal W, N\nLot --> s(6, 0, 4) extrude(3) comp(f) { side: split(x) { ~1: W | 1: N | ~1: W }* | all: NIL }\n"
+        )
+    )
+)
 
 
 @settings(max_examples=200, deadline=None, suppress_health_check=[HealthCheck.too_slow])
@@ -261,9 +308,29 @@ def test_fuzz_mutated_terminal_lists_raise_only_bgr_errors(data):
     for _ in range(data.draw(st.integers(1, 4))):
         t = terms[data.draw(st.integers(0, len(terms) - 1))]
         key = data.draw(st.sampled_from(["label", "path", "origin", "axes", "size"]))
-        t[key] = data.draw(st.one_of(
-            _JSON, st.lists(st.floats(-1e9, 1e9), min_size=3, max_size=3),
-            st.sampled_from(["", "Lot", "Lot/A.0", "Lot//", "/", "W", "shop-window", "split", "NIL", "1st", "é", [[0, 0, 0]] * 3, [[1, 0, 0], [0, 0, 1], [0, 1, 0]]])))
+        t[key] = data.draw(
+            st.one_of(
+                _JSON,
+                st.lists(st.floats(-1e9, 1e9), min_size=3, max_size=3),
+                st.sampled_from(
+                    [
+                        "",
+                        "Lot",
+                        "Lot/A.0",
+                        "Lot//",
+                        "/",
+                        "W",
+                        "shop-window",
+                        "split",
+                        "NIL",
+                        "1st",
+                        "é",
+                        [[0, 0, 0]] * 3,
+                        [[1, 0, 0], [0, 0, 1], [0, 1, 0]],
+                    ]
+                ),
+            )
+        )
     _only_bgr_errors({"terminals": terms})
 
 
@@ -273,9 +340,12 @@ def test_captured_example_grammar_is_current_and_restyles_an_l_lot():
     folder = ROOT / "examples" / "captured"
     text = bgr.format_module(infer(folder / "corner_shop.json"))
     committed = (folder / "corner_shop.bgr").read_text(encoding="utf-8")
-    assert text.split("\n", 1)[1] == committed.split("\n", 1)[1], \
+    assert text.split("\n", 1)[1] == committed.split("\n", 1)[1], (
         "rerun: bgr infer examples/captured/corner_shop.json -o examples/captured/corner_shop.bgr"
-    result = bgr.derive(bgr.load(committed), lot=str(folder / "l_lot.geojson"), attrs={"height": 18.8})
+    )
+    result = bgr.derive(
+        bgr.load(committed), lot=str(folder / "l_lot.geojson"), attrs={"height": 18.8}
+    )
     assert len(result) > 200
 
 
@@ -287,11 +357,22 @@ def test_floor_schema_prefers_the_face_with_fewest_occluded_subfaces():
     def face(label, occluded, x_axis, origin):
         leaf = Cell(4.0, label, occluded=occluded)
         root = Cell(10.0, axis="x", parts=[Cell(3.0, "Wall"), leaf, Cell(3.0, "Wall")])
-        return Face(10.0, 4.0, root, left="outer", right="outer", name=label, origin=origin,
-                    x_axis=x_axis, normal=(-x_axis[2], 0.0, x_axis[0]))
+        return Face(
+            10.0,
+            4.0,
+            root,
+            left="outer",
+            right="outer",
+            name=label,
+            origin=origin,
+            x_axis=x_axis,
+            normal=(-x_axis[2], 0.0, x_axis[0]),
+        )
 
-    faces = [face("Hidden", True, (0.0, 0.0, 1.0), (10.0, 0.0, 0.0)),  # normal (-1, 0, 0): left
-             face("Seen", False, (0.0, 0.0, -1.0), (0.0, 0.0, 10.0))]  # normal (1, 0, 0): right
+    faces = [
+        face("Hidden", True, (0.0, 0.0, 1.0), (10.0, 0.0, 0.0)),  # normal (-1, 0, 0): left
+        face("Seen", False, (0.0, 0.0, -1.0), (0.0, 0.0, 10.0)),
+    ]  # normal (1, 0, 0): right
     for f in faces:
         f.normal = (0.0, 0.0, 1.0)  # both face the back: same side, same corners, same width
     model = Model([Block("b", faces, 10, 10, 4)])
@@ -301,7 +382,9 @@ def test_floor_schema_prefers_the_face_with_fewest_occluded_subfaces():
     assert "Seen" in labels and "Hidden" not in labels
 
 
-@pytest.mark.parametrize("name, blocks", [("house.bgr", 1), ("stdlib_street.bgr", 1), ("tower.bgr", 2)])
+@pytest.mark.parametrize(
+    "name, blocks", [("house.bgr", 1), ("stdlib_street.bgr", 1), ("tower.bgr", 2)]
+)
 def test_grammars_with_3d_parts_give_one_face_per_wall(name, blocks):
     """Recessed glass, frames, sills and reveals at right angles belong to the wall they are set
     in: the shipped examples (3D windows, roofs, setbacks) give closed rings of whole walls."""
@@ -324,9 +407,17 @@ F --> split(x) { ~1: Wall | 1.2: split(y) { 2.4: Door | ~1: Wall } | { ~1: Wall 
 
 
 def _geojson(tmp_path, rings) -> str:
-    geo = {"type": "FeatureCollection", "features": [
-        {"type": "Feature", "properties": {}, "geometry": {"type": "Polygon", "coordinates": [r + [r[0]]]}}
-        for r in rings]}
+    geo = {
+        "type": "FeatureCollection",
+        "features": [
+            {
+                "type": "Feature",
+                "properties": {},
+                "geometry": {"type": "Polygon", "coordinates": [r + [r[0]]]},
+            }
+            for r in rings
+        ],
+    }
     path = tmp_path / "lots.geojson"
     path.write_text(json.dumps(geo))
     return str(path)
@@ -339,11 +430,21 @@ def _same(src_result, grammar, lot) -> None:
     np.testing.assert_allclose([t["origin"] for t in a], [t["origin"] for t in b], atol=1e-6)
 
 
-@pytest.mark.parametrize("rings", [
-    [[[0, 0], [16, 0], [16, 14], [0, 14]], [[20, 0], [34, 0], [34, 14], [20, 14]],
-     [[38, 2], [52, 0], [54, 14], [38, 14]]],  # three lots, one a trapezoid: fronts face south
-    [[[0, 0], [10, 0], [10, 12], [0, 12]], [[10, 0], [20, 0], [20, 12], [10, 12]]],  # touching lots
-], ids=["geojson", "touching"])
+@pytest.mark.parametrize(
+    "rings",
+    [
+        [
+            [[0, 0], [16, 0], [16, 14], [0, 14]],
+            [[20, 0], [34, 0], [34, 14], [20, 14]],
+            [[38, 2], [52, 0], [54, 14], [38, 14]],
+        ],  # three lots, one a trapezoid: fronts face south
+        [
+            [[0, 0], [10, 0], [10, 12], [0, 12]],
+            [[10, 0], [20, 0], [20, 12], [10, 12]],
+        ],  # touching lots
+    ],
+    ids=["geojson", "touching"],
+)
 def test_round_trip_on_geojson_lots_keeps_each_face_on_its_side(rings, tmp_path):
     """Sides are read in each lot's frame (a GeoJSON lot's front faces +z), and faces of two
     lots that touch are two buildings."""
@@ -355,14 +456,21 @@ def test_round_trip_on_geojson_lots_keeps_each_face_on_its_side(rings, tmp_path)
     _same(src, style(src), lot)
 
 
-@pytest.mark.parametrize("front", [
-    "split(x) { { ~1: Wall | 1.2: split(y) { 2.5: Door } | ~1: Wall }* }",  # a door shorter than its column
-    ("split(x) { 1: Pier | 1.5: Window | 1: Pier | 1.5: Window | 1: Pier | 1.5: Window | 1: Pier | 2: Door "
-     "| 1: Pier | 1.5: Window | 1: Pier | 1.5: Window | 1: Pier | ~1: Wall }"),  # bays, a door, bays
-])
+@pytest.mark.parametrize(
+    "front",
+    [
+        "split(x) { { ~1: Wall | 1.2: split(y) { 2.5: Door } | ~1: Wall }* }",  # a door shorter than its column
+        (
+            "split(x) { 1: Pier | 1.5: Window | 1: Pier | 1.5: Window | 1: Pier | 1.5: Window | 1: Pier | 2: Door "
+            "| 1: Pier | 1.5: Window | 1: Pier | 1.5: Window | 1: Pier | ~1: Wall }"
+        ),  # bays, a door, bays
+    ],
+)
 def test_round_trip_of_nested_gaps_and_tied_groups(front):
-    src_text = ("terminal Wall, Window, Door, Pier\n"
-                f"Lot --> s(17, 0, 10) extrude(4) comp(f) {{ front: {front} | side: Wall | top: NIL | bottom: NIL }}\n")
+    src_text = (
+        "terminal Wall, Window, Door, Pier\n"
+        f"Lot --> s(17, 0, 10) extrude(4) comp(f) {{ front: {front} | side: Wall | top: NIL | bottom: NIL }}\n"
+    )
     src = bgr.derive(bgr.load(src_text))
     text = bgr.format_module(infer(src))
     _same(src, bgr.load(text), (17, 10))
@@ -373,10 +481,13 @@ def test_round_trip_of_nested_gaps_and_tied_groups(front):
 def test_a_face_with_an_edge_gap_is_kept():
     """A gap at the edge of a face narrows it (its extent is its terminals'), but the face stays a
     face of the mass: its schema is not lost."""
-    src = bgr.derive(bgr.load(
-        "terminal Wall, Window\n"
-        "Lot --> s(20, 0, 12) extrude(6) comp(f) { front: F | side: Wall | top: NIL | bottom: NIL }\n"
-        "F --> split(x) { 1: Wall | 1: Wall | 1: Wall | 2: Window | 1: Wall | 1: Wall | 1.5: Wall }\n"))
+    src = bgr.derive(
+        bgr.load(
+            "terminal Wall, Window\n"
+            "Lot --> s(20, 0, 12) extrude(6) comp(f) { front: F | side: Wall | top: NIL | bottom: NIL }\n"
+            "F --> split(x) { 1: Wall | 1: Wall | 1: Wall | 2: Window | 1: Wall | 1: Wall | 1.5: Wall }\n"
+        )
+    )
     model = read_model(src)
     assert model.dropped == 0 and len(model.faces()) == 4
     out = terminals(bgr.derive(style(src), lot=(20, 12)))
@@ -387,9 +498,16 @@ def test_terminal_list_lists_each_lot_with_its_frame(tmp_path):
     """`lots` in the terminal list: the path each lot's terminals start with, and its axes."""
     rings = [[[0, 0], [10, 0], [10, 12], [0, 12]], [[10, 0], [20, 0], [20, 12], [10, 12]]]
     buffer = io.StringIO()
-    write_json(bgr.derive(bgr.load(FRONT_DOOR), lot=_geojson(tmp_path, rings)).terminals, buffer, seed=0, attrs={})
+    write_json(
+        bgr.derive(bgr.load(FRONT_DOOR), lot=_geojson(tmp_path, rings)).terminals,
+        buffer,
+        seed=0,
+        attrs={},
+    )
     data = json.loads(buffer.getvalue())
     lots = data["lots"]
     assert [lot["path"] for lot in lots] == ["Lot.0", "Lot.1"]
     assert {t["path"].split("/")[0] for t in data["terminals"]} == {"Lot.0", "Lot.1"}
-    np.testing.assert_allclose(lots[0]["axes"][2], [0, 0, -1], atol=1e-12)  # into the lot: north is -z
+    np.testing.assert_allclose(
+        lots[0]["axes"][2], [0, 0, -1], atol=1e-12
+    )  # into the lot: north is -z

@@ -31,6 +31,7 @@ def modules():
 
 # ---- counts and documentation ----------------------------------------------------------------
 
+
 def test_family_counts_follow_the_paper(modules):
     """Figure 3: 30 masses; Figure 5: 16 façades; Figure 6: 31 windows, 6 of them entrances."""
     assert len(public(modules["mass"])) == 30
@@ -49,18 +50,25 @@ def test_every_public_rule_is_documented_with_every_parameter(name):
         rule = grammar.rules[rule_name]
         assert rule_name in docs, f"{name}.bgr: rule {rule_name} has no doc comment"
         doc = docs[rule_name]
-        assert doc.named and doc.summary, f"{name}.bgr: {rule_name}'s doc must start '# {rule_name}: ...'"
-        assert list(doc.params) == rule.params, f"{name}.bgr: {rule_name} documents {list(doc.params)}"
+        assert doc.named and doc.summary, (
+            f"{name}.bgr: {rule_name}'s doc must start '# {rule_name}: ...'"
+        )
+        assert list(doc.params) == rule.params, (
+            f"{name}.bgr: {rule_name} documents {list(doc.params)}"
+        )
         missing = [p for i, p in enumerate(rule.params) if rule.default(i) is None]
         assert not missing, f"{name}.bgr: {rule_name} has parameters without defaults: {missing}"
 
 
 # ---- every rule derives ----------------------------------------------------------------------
 
+
 def _wrapper(mod: str, names: list[str]) -> bgr.Grammar:
     """One start rule per public rule of ``mod``, applying it to the front face of a W x H wall."""
     lines = [f"import stdlib.{mod} as lib", "attr W = 1", "attr H = 1"]
-    lines += [f"T_{n} --> s(W, 0, 1) extrude(H) comp(f) {{ front: lib.{n} | all: NIL }}" for n in names]
+    lines += [
+        f"T_{n} --> s(W, 0, 1) extrude(H) comp(f) {{ front: lib.{n} | all: NIL }}" for n in names
+    ]
     return bgr.load("\n".join(lines) + "\n", path=ROOT / "tests" / f"_{mod}_wrapper.bgr")
 
 
@@ -138,11 +146,13 @@ def test_mass_facade_and_window_compose_in_under_fifteen_lines(tmp_path):
     # the same grammar through the CLI
     out = tmp_path / "composed.glb"
     from bgr.cli import main
+
     assert main(["derive", str(path), "--seed", "1", "-o", str(out)]) == 0
     assert out.stat().st_size > 1000
 
 
 # ---- the generated reference -----------------------------------------------------------------
+
 
 def test_stdlib_reference_is_current_and_every_thumbnail_exists():
     """docs/stdlib.md is generated (python -m bgr.grammar.stdlib_reference); thumbnails by

@@ -23,8 +23,20 @@ from bgr.interpreter.writers.glb_read import parse, quat_matrix
 QUAD_V = [[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0]]
 QUAD_F = [[0, 1, 2], [0, 2, 3]]
 BOX_V = [[x, y, z] for x in (0, 1) for y in (0, 1) for z in (0, 1)]
-BOX_F = [[0, 1, 3], [0, 3, 2], [4, 6, 7], [4, 7, 5], [0, 4, 5], [0, 5, 1],
-         [2, 3, 7], [2, 7, 6], [0, 2, 6], [0, 6, 4], [1, 5, 7], [1, 7, 3]]
+BOX_F = [
+    [0, 1, 3],
+    [0, 3, 2],
+    [4, 6, 7],
+    [4, 7, 5],
+    [0, 4, 5],
+    [0, 5, 1],
+    [2, 3, 7],
+    [2, 7, 6],
+    [0, 2, 6],
+    [0, 6, 4],
+    [1, 5, 7],
+    [1, 7, 3],
+]
 FORMATS = ["glb", "gltf", "obj", "ply", "stl"]
 
 
@@ -64,11 +76,27 @@ def city_table(boxes: int = 40, quads: int = 30, seed: int = 1) -> TerminalTable
     quad = t.library.add(UnitMesh("quad", QUAD_V, QUAD_F))
     box = t.library.add(UnitMesh("cube", BOX_V, BOX_F))
     for i in range(boxes):
-        add(t, "Mass", box, rng.uniform(-50, 50, 3), rot_y(rng.uniform(0, 360)),
-            rng.uniform(1, 10, 3), (0.6, 0.6, 0.55))
+        add(
+            t,
+            "Mass",
+            box,
+            rng.uniform(-50, 50, 3),
+            rot_y(rng.uniform(0, 360)),
+            rng.uniform(1, 10, 3),
+            (0.6, 0.6, 0.55),
+        )
     for i in range(quads):
         axes = np.array([[1, 0, 0], [0, 0, -1], [0, 1, 0]]) if i % 2 else rot_y(90 * i)
-        add(t, "Window", quad, rng.uniform(-50, 50, 3), axes, (1.2, 1.5, 0.0), (0.2, 0.3, 0.4), "glass")
+        add(
+            t,
+            "Window",
+            quad,
+            rng.uniform(-50, 50, 3),
+            axes,
+            (1.2, 1.5, 0.0),
+            (0.2, 0.3, 0.4),
+            "glass",
+        )
     mirror = np.diag([1.0, 1.0, -1.0])  # a left-handed frame: baked and re-wound
     add(t, "Mirror", box, (60, 0, 0), mirror, (2, 2, 2), (0.9, 0.9, 0.9))
     poly = t.library.add(UnitMesh("polygon", [[0, 0, 0], [1, 0, 0], [0.5, 0, 1]], [[0, 2, 1]]))
@@ -116,7 +144,9 @@ def validate_glb(path: Path) -> dict:
     for view in gltf.get("bufferViews", []):
         assert view["buffer"] < len(buffers)
         assert view.get("byteOffset", 0) % 4 == 0
-        assert view.get("byteOffset", 0) + view["byteLength"] <= buffers[view["buffer"]]["byteLength"]
+        assert (
+            view.get("byteOffset", 0) + view["byteLength"] <= buffers[view["buffer"]]["byteLength"]
+        )
 
     accessors = gltf.get("accessors", [])
     for acc in accessors:
@@ -128,6 +158,7 @@ def validate_glb(path: Path) -> dict:
 
     def read(index: int) -> np.ndarray:
         from bgr.interpreter.writers.glb_read import accessor
+
         return accessor(gltf, blob, index)
 
     materials = gltf.get("materials", [])
@@ -157,7 +188,9 @@ def validate_glb(path: Path) -> dict:
             if name == "EXT_mesh_gpu_instancing":
                 counts = {accessors[i]["count"] for i in ext["attributes"].values()}
                 assert len(counts) == 1
-                assert np.allclose(np.linalg.norm(read(ext["attributes"]["ROTATION"]), axis=1), 1.0, atol=1e-6)
+                assert np.allclose(
+                    np.linalg.norm(read(ext["attributes"]["ROTATION"]), axis=1), 1.0, atol=1e-6
+                )
                 for i in ext["attributes"].values():
                     assert "target" not in gltf["bufferViews"][accessors[i]["bufferView"]]
     assert used == set(gltf.get("extensionsUsed", []))
@@ -169,7 +202,9 @@ def validate_glb(path: Path) -> dict:
 def canonical_triangles(mesh: trimesh.Trimesh) -> np.ndarray:
     """(F, 9) triangles, each rotated (keeping its winding) to start at its smallest corner."""
     tri = mesh.vertices[mesh.faces]
-    first = np.lexsort(np.round(tri, 4).transpose(2, 0, 1)[::-1].reshape(3, -1))  # corners by position
+    first = np.lexsort(
+        np.round(tri, 4).transpose(2, 0, 1)[::-1].reshape(3, -1)
+    )  # corners by position
     rank = np.empty(tri.shape[0] * 3, dtype=int)
     rank[first] = np.arange(len(first))
     start = rank.reshape(-1, 3).argmin(axis=1)
@@ -184,8 +219,8 @@ def same_triangles(a: trimesh.Trimesh, b: trimesh.Trimesh, atol: float) -> bool:
         return False
     near_a, near_b = np.full(len(ta), np.inf), np.full(len(tb), np.inf)
     for lo in range(0, len(ta), 256):
-        gap = np.abs(ta[lo:lo + 256, None, :] - tb[None, :, :]).max(axis=2)
-        near_a[lo:lo + 256] = gap.min(axis=1)
+        gap = np.abs(ta[lo : lo + 256, None, :] - tb[None, :, :]).max(axis=2)
+        near_a[lo : lo + 256] = gap.min(axis=1)
         near_b = np.minimum(near_b, gap.min(axis=0))
     return bool((near_a < atol).all() and (near_b < atol).all())
 
@@ -205,7 +240,9 @@ def test_every_format_loads_back(tmp_path, fmt):
     assert np.allclose(mesh.bounds, expected_bounds(t), atol=1e-5)
     if fmt == "obj":
         assert (tmp_path / "out.mtl").exists()
-    assert sorted(p.name for p in tmp_path.iterdir()) == sorted([path.name] + (["out.mtl"] if fmt == "obj" else []))
+    assert sorted(p.name for p in tmp_path.iterdir()) == sorted(
+        [path.name] + (["out.mtl"] if fmt == "obj" else [])
+    )
 
 
 @pytest.mark.parametrize("fmt", ["glb", "gltf"])
@@ -233,10 +270,14 @@ def test_colours_survive(tmp_path):
     write(t, tmp_path / "a.glb", seed=0, attrs={})
     write(t, tmp_path / "a.ply", seed=0, attrs={})
     back = read_glb(tmp_path / "a.glb")
-    assert {color_hex(c[:3] / 255) for c in back.visual.face_colors} == {color_hex(c) for c in t.color}
+    assert {color_hex(c[:3] / 255) for c in back.visual.face_colors} == {
+        color_hex(c) for c in t.color
+    }
     ply = trimesh.load(tmp_path / "a.ply", process=False)
-    assert {color_hex(c[:3] / 255) for c in ply.visual.vertex_colors} == {color_hex(c) for c in t.color}
-    mtl = (tmp_path / "b.mtl")
+    assert {color_hex(c[:3] / 255) for c in ply.visual.vertex_colors} == {
+        color_hex(c) for c in t.color
+    }
+    mtl = tmp_path / "b.mtl"
     write(t, tmp_path / "b.obj", seed=0, attrs={})
     text = mtl.read_text()
     assert "newmtl brick" in text and "newmtl c_3b4a59" in text and "Kd 0.8 0.2 0.101961" in text
@@ -258,15 +299,24 @@ def test_json_is_exactly_the_terminal_list(tmp_path):
     keys = ["label", "rule", "path", "origin", "axes", "size", "color", "material", "geometry"]
     for i, term in enumerate(doc["terminals"]):
         assert list(term) == keys
-        assert term["label"] == t.label[i] and term["rule"] == t.rule[i] and term["path"] == t.path[i]
+        assert (
+            term["label"] == t.label[i] and term["rule"] == t.rule[i] and term["path"] == t.path[i]
+        )
         assert term["origin"] == t.origin[i].tolist()  # exact: floats round-trip
         assert term["axes"] == t.axes[i].tolist()
         assert term["size"] == t.size[i].tolist()
         assert term["color"] == color_hex(t.color[i])
     assert doc["terminals"][0] == {
-        "label": "Window", "rule": "Window", "path": "Lot/Window.0", "origin": [0.0, 3.2, 0.0],
-        "axes": [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]], "size": [1.5, 2.0, 0.0],
-        "color": "#3b4a59", "material": None, "geometry": "quad"}
+        "label": "Window",
+        "rule": "Window",
+        "path": "Lot/Window.0",
+        "origin": [0.0, 3.2, 0.0],
+        "axes": [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]],
+        "size": [1.5, 2.0, 0.0],
+        "color": "#3b4a59",
+        "material": None,
+        "geometry": "quad",
+    }
     assert doc["terminals"][1]["material"] == "brick" and doc["terminals"][2]["geometry"] == "cube"
     assert doc["terminals"][2]["axes"][0] == rot_y(30)[0].tolist()
     assert "-0.0" not in path.read_text()
@@ -288,7 +338,12 @@ def test_json_to_a_stream_and_stdout(tmp_path, capsys):
 def test_empty_table(tmp_path, fmt):
     write(TerminalTable(), tmp_path / f"e.{fmt}", seed=0, attrs={})
     if fmt == "json":
-        assert json.loads((tmp_path / "e.json").read_text()) == {"bgr": 1, "seed": 0, "attrs": {}, "terminals": []}
+        assert json.loads((tmp_path / "e.json").read_text()) == {
+            "bgr": 1,
+            "seed": 0,
+            "attrs": {},
+            "terminals": [],
+        }
     else:
         assert (tmp_path / f"e.{fmt}").stat().st_size > 0
 
@@ -305,7 +360,9 @@ def test_glb_structure(tmp_path):
     assert gltf["materials"][1]["extras"] == {"color": "#cc331a", "material": "brick"}
     assert gltf["asset"]["extras"] == {"bgr": 1, "seed": 3, "attrs": {"height": 18}}
     # sRGB 0.8 -> linear 0.603827
-    assert gltf["materials"][1]["pbrMetallicRoughness"]["baseColorFactor"][0] == pytest.approx(0.603827)
+    assert gltf["materials"][1]["pbrMetallicRoughness"]["baseColorFactor"][0] == pytest.approx(
+        0.603827
+    )
 
 
 def test_glb_normals_point_out(tmp_path):
@@ -315,6 +372,7 @@ def test_glb_normals_point_out(tmp_path):
     write(t, path, seed=0, attrs={})
     gltf, blob = parse(path.read_bytes())
     from bgr.interpreter.writers.glb_read import accessor
+
     prim = gltf["meshes"][0]["primitives"]
     for p in prim:
         pos = accessor(gltf, blob, p["attributes"]["POSITION"]).reshape(-1, 3, 3)
@@ -365,12 +423,20 @@ def test_bulk_paths_agree_with_one_by_one(tmp_path):
     rng = np.random.default_rng(9)
     t = TerminalTable()
     box = t.library.add(UnitMesh("cube", BOX_V, BOX_F))
-    polys = [t.library.add(UnitMesh("polygon", np.array(QUAD_V) * [rng.uniform(0.5, 1), 1, 0], QUAD_F),
-                           key=("p", i)) for i in range(60)]
+    polys = [
+        t.library.add(
+            UnitMesh("polygon", np.array(QUAD_V) * [rng.uniform(0.5, 1), 1, 0], QUAD_F),
+            key=("p", i),
+        )
+        for i in range(60)
+    ]
     palette = rng.uniform(0, 1, (40, 3))  # materials shared by boxes and polygons: scattered runs
     rows = [("Poly", p, palette[i % 40]) for i, p in enumerate(polys)]
     rows += [("Box", box, palette[i % 40]) for i in range(100)]
-    rows += [("Flat", box, (0.4, 0.4, 0.4)), ("Empty", t.library.add(UnitMesh("empty", [], [])), (0, 0, 0))]
+    rows += [
+        ("Flat", box, (0.4, 0.4, 0.4)),
+        ("Empty", t.library.add(UnitMesh("empty", [], [])), (0, 0, 0)),
+    ]
     for j in rng.permutation(len(rows)):
         label, mesh, colour = rows[j]
         size = (3, 0, 2) if label == "Flat" else rng.uniform(0.5, 5, 3)
@@ -392,8 +458,15 @@ def test_quaternions_match_the_axes():
     rng = np.random.default_rng(5)
     q, _ = np.linalg.qr(rng.normal(size=(200, 3, 3)))
     q[np.linalg.det(q) < 0, 2] *= -1  # right-handed
-    special = np.array([np.eye(3), np.diag([-1.0, -1.0, 1.0]), np.diag([1.0, -1.0, -1.0]),
-                        np.diag([-1.0, 1.0, -1.0]), rot_y(180)])
+    special = np.array(
+        [
+            np.eye(3),
+            np.diag([-1.0, -1.0, 1.0]),
+            np.diag([1.0, -1.0, -1.0]),
+            np.diag([-1.0, 1.0, -1.0]),
+            rot_y(180),
+        ]
+    )
     axes = np.concatenate([q, special])
     quat = glb_module.quaternions(axes)
     assert np.allclose(np.linalg.norm(quat, axis=1), 1.0)
@@ -405,7 +478,15 @@ def test_far_from_the_origin_keeps_precision(tmp_path):
     t = TerminalTable()
     box = t.library.add(UnitMesh("cube", BOX_V, BOX_F))
     for i in range(3):
-        add(t, "Box", box, (500000.0 + 0.001 * i, 20.0, 4000000.0), np.eye(3), (0.01, 0.01, 0.01), (1, 1, 1))
+        add(
+            t,
+            "Box",
+            box,
+            (500000.0 + 0.001 * i, 20.0, 4000000.0),
+            np.eye(3),
+            (0.01, 0.01, 0.01),
+            (1, 1, 1),
+        )
     t.freeze()
     path = tmp_path / "far.glb"
     write(t, path, seed=0, attrs={})

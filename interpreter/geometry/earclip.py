@@ -75,11 +75,17 @@ def _find_ear(poly: np.ndarray, eps: float) -> int:
         others[[(i - 1) % m, i, (i + 1) % m]] = False
         q = poly[others]
         # a vertex sitting exactly on a, b or c (a pinch) does not block the ear
-        same = (np.all(np.abs(q - a) <= 1e-12, axis=1) | np.all(np.abs(q - c) <= 1e-12, axis=1)
-                | np.all(np.abs(q - b) <= 1e-12, axis=1))
+        same = (
+            np.all(np.abs(q - a) <= 1e-12, axis=1)
+            | np.all(np.abs(q - c) <= 1e-12, axis=1)
+            | np.all(np.abs(q - b) <= 1e-12, axis=1)
+        )
         q = q[~same]
-        inside = ((_cross(b - a, q - a) >= -eps) & (_cross(c - b, q - b) >= -eps)
-                  & (_cross(a - c, q - c) >= -eps))
+        inside = (
+            (_cross(b - a, q - a) >= -eps)
+            & (_cross(c - b, q - b) >= -eps)
+            & (_cross(a - c, q - c) >= -eps)
+        )
         if not inside.any():
             return int(i)
     return int(np.argmax(turn))
@@ -89,8 +95,14 @@ def _shape(p, a: int, b: int, c: int) -> float:
     """Shape quality of a counter-clockwise triangle: area over the sum of its squared sides
     (1 / (4 sqrt 3) for an equilateral one, 0 for a sliver)."""
     (ax, ay), (bx, by), (cx, cy) = p[a], p[b], p[c]
-    sides = (bx - ax) ** 2 + (by - ay) ** 2 + (cx - bx) ** 2 + (cy - by) ** 2 + (ax - cx) ** 2 \
+    sides = (
+        (bx - ax) ** 2
+        + (by - ay) ** 2
+        + (cx - bx) ** 2
+        + (cy - by) ** 2
+        + (ax - cx) ** 2
         + (ay - cy) ** 2
+    )
     return 0.5 * ((bx - ax) * (cy - ay) - (by - ay) * (cx - ax)) / sides
 
 

@@ -52,8 +52,10 @@ def prism_mesh(polys, k: int) -> tuple[np.ndarray, np.ndarray]:
     bottom, top = _lift(pts2, k, 0.0), _lift(pts2, k, 1.0)
     normal = np.eye(3)[k]
     verts = [bottom, top]
-    faces = [_orient(bottom, tris, lambda c: np.broadcast_to(-normal, c.shape)),
-             _orient(top, tris, lambda c: np.broadcast_to(normal, c.shape)) + len(bottom)]
+    faces = [
+        _orient(bottom, tris, lambda c: np.broadcast_to(-normal, c.shape)),
+        _orient(top, tris, lambda c: np.broadcast_to(normal, c.shape)) + len(bottom),
+    ]
     base = len(bottom) + len(top)
     for ext, holes in polys:
         for ring, is_hole in [(ext, False)] + [(h, True) for h in holes]:
@@ -69,7 +71,11 @@ def prism_mesh(polys, k: int) -> tuple[np.ndarray, np.ndarray]:
                 if _inside(inside_probe, ext, holes) == is_hole:
                     n2 = -n2
                 n3 = _lift(n2[None, :], k, 0.0)[0]
-                tri = _orient(quad, np.array([[0, 1, 2], [0, 2, 3]]), lambda c, n3=n3: np.broadcast_to(n3, c.shape))
+                tri = _orient(
+                    quad,
+                    np.array([[0, 1, 2], [0, 2, 3]]),
+                    lambda c, n3=n3: np.broadcast_to(n3, c.shape),
+                )
                 verts.append(quad)
                 faces.append(tri + base)
                 base += 4
@@ -85,6 +91,7 @@ def _inside(pt, ext, holes) -> bool:
             if (y0 > y) != (y1 > y) and x < (x1 - x0) * (y - y0) / (y1 - y0) + x0:
                 inside = not inside
         return inside
+
     return in_ring(ext) and not any(in_ring(h) for h in holes)
 
 
@@ -100,8 +107,10 @@ def primitive(name: str) -> tuple[np.ndarray, np.ndarray]:
         return prism_mesh(tri, 0)
     if name == "cylinder":
         n = 24
-        ring = tuple((0.5 + 0.5 * math.cos(2 * math.pi * i / n), 0.5 + 0.5 * math.sin(2 * math.pi * i / n))
-                     for i in range(n))
+        ring = tuple(
+            (0.5 + 0.5 * math.cos(2 * math.pi * i / n), 0.5 + 0.5 * math.sin(2 * math.pi * i / n))
+            for i in range(n)
+        )
         return prism_mesh([(ring, ())], 1)
     if name == "sphere":
         rows, cols = 12, 24
@@ -110,8 +119,13 @@ def primitive(name: str) -> tuple[np.ndarray, np.ndarray]:
             phi = math.pi * r / rows
             for c in range(cols):
                 th = 2 * math.pi * c / cols
-                verts.append((0.5 + 0.5 * math.sin(phi) * math.cos(th), 0.5 + 0.5 * math.cos(phi),
-                              0.5 + 0.5 * math.sin(phi) * math.sin(th)))
+                verts.append(
+                    (
+                        0.5 + 0.5 * math.sin(phi) * math.cos(th),
+                        0.5 + 0.5 * math.cos(phi),
+                        0.5 + 0.5 * math.sin(phi) * math.sin(th),
+                    )
+                )
         for r in range(rows):
             for c in range(cols):
                 a, b = r * cols + c, r * cols + (c + 1) % cols

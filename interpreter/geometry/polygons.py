@@ -30,7 +30,9 @@ def from_shapely(geom) -> list[Poly]:
     for g in getattr(geom, "geoms", [geom]):
         if isinstance(g, Polygon) and g.area > 1e-12:
             g = shapely.geometry.polygon.orient(g)
-            out.append((tuple(g.exterior.coords[:-1]), tuple(tuple(h.coords[:-1]) for h in g.interiors)))
+            out.append(
+                (tuple(g.exterior.coords[:-1]), tuple(tuple(h.coords[:-1]) for h in g.interiors))
+            )
         elif hasattr(g, "geoms"):
             out += from_shapely(g)
     return out
@@ -50,6 +52,7 @@ def renormalise(polys: list[Poly], axis: int, lo: float, hi: float) -> list[Poly
 
     def f(pt):
         return ((pt[0] - lo) / span, pt[1]) if axis == 0 else (pt[0], (pt[1] - lo) / span)
+
     return [(tuple(map(f, ext)), tuple(tuple(map(f, h)) for h in holes)) for ext, holes in polys]
 
 
@@ -59,13 +62,22 @@ def is_unit_square(polys: list[Poly], tol: float = 1e-9) -> bool:
     ring = polys[0][0]
     if len(ring) != 4:
         return False
-    return sorted((round(x / tol) * tol, round(y / tol) * tol) for x, y in ring) == \
-        [(0.0, 0.0), (0.0, 1.0), (1.0, 0.0), (1.0, 1.0)]
+    return sorted((round(x / tol) * tol, round(y / tol) * tol) for x, y in ring) == [
+        (0.0, 0.0),
+        (0.0, 1.0),
+        (1.0, 0.0),
+        (1.0, 1.0),
+    ]
 
 
 def metric(polys: list[Poly], su: float, sv: float) -> list[Poly]:
-    return [(tuple((x * su, y * sv) for x, y in ext), tuple(tuple((x * su, y * sv) for x, y in h) for h in holes))
-            for ext, holes in polys]
+    return [
+        (
+            tuple((x * su, y * sv) for x, y in ext),
+            tuple(tuple((x * su, y * sv) for x, y in h) for h in holes),
+        )
+        for ext, holes in polys
+    ]
 
 
 def normalise(polys: list[Poly]) -> tuple[list[Poly], tuple[float, float, float, float]]:
@@ -77,10 +89,18 @@ def normalise(polys: list[Poly]) -> tuple[list[Poly], tuple[float, float, float,
 
     def f(pt):
         return ((pt[0] - x0) / w, (pt[1] - y0) / h)
-    return [(tuple(map(f, e)), tuple(tuple(map(f, r)) for r in hs)) for e, hs in polys], (x0, y0, x1 - x0, y1 - y0)
+
+    return [(tuple(map(f, e)), tuple(tuple(map(f, r)) for r in hs)) for e, hs in polys], (
+        x0,
+        y0,
+        x1 - x0,
+        y1 - y0,
+    )
 
 
-def inset(polys: list[Poly], su: float, sv: float, distance: float) -> tuple[list[Poly], list[Poly]]:
+def inset(
+    polys: list[Poly], su: float, sv: float, distance: float
+) -> tuple[list[Poly], list[Poly]]:
     """(inside, border) of an offset by ``distance`` metres (positive shrinks), in metric coords."""
     shape = to_shapely(metric(polys, su, sv))
     inner = shape.buffer(-distance, join_style="mitre", mitre_limit=10.0)
@@ -132,12 +152,26 @@ def named_footprint(kind: str, a: float, b: float) -> list[Poly]:
         ring = ((0, 0), (1, 0), (1, b), (hi, b), (hi, 1), (lo, 1), (lo, b), (0, b))
     elif kind == "cross":  # a centred bar each way
         ulo, uhi, vlo, vhi = 0.5 - a / 2, 0.5 + a / 2, 0.5 - b / 2, 0.5 + b / 2
-        ring = ((ulo, 0), (uhi, 0), (uhi, vlo), (1, vlo), (1, vhi), (uhi, vhi), (uhi, 1), (ulo, 1),
-                (ulo, vhi), (0, vhi), (0, vlo), (ulo, vlo))
+        ring = (
+            (ulo, 0),
+            (uhi, 0),
+            (uhi, vlo),
+            (1, vlo),
+            (1, vhi),
+            (uhi, vhi),
+            (uhi, 1),
+            (ulo, 1),
+            (ulo, vhi),
+            (0, vhi),
+            (0, vlo),
+            (ulo, vlo),
+        )
     elif kind == "circle":
         n = int(a)
         angles = -np.pi / 2 - np.pi / n + 2 * np.pi * np.arange(n) / n
-        ring = tuple(zip((0.5 + 0.5 * np.cos(angles)).tolist(), (0.5 + 0.5 * np.sin(angles)).tolist()))
+        ring = tuple(
+            zip((0.5 + 0.5 * np.cos(angles)).tolist(), (0.5 + 0.5 * np.sin(angles)).tolist())
+        )
     else:
         raise ValueError(f"unknown footprint {kind!r}")
     return [(tuple((float(u), float(v)) for u, v in ring), ())]

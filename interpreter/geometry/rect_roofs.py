@@ -15,7 +15,9 @@ import math
 import numpy as np
 
 
-def rectangle_hip(width: float, depth: float, pitch: float, overhang: float = 0.0) -> tuple[np.ndarray, np.ndarray]:
+def rectangle_hip(
+    width: float, depth: float, pitch: float, overhang: float = 0.0
+) -> tuple[np.ndarray, np.ndarray]:
     """(vertices (6, 3), faces (6, 3)) of a hip roof on [0, width] x [0, depth], z up, CCW from above."""
     if width < depth:  # build it along x, then turn it a quarter (a rotation keeps the winding)
         v, f = rectangle_hip(depth, width, pitch, overhang)
@@ -23,14 +25,26 @@ def rectangle_hip(width: float, depth: float, pitch: float, overhang: float = 0.
     t, o = math.tan(math.radians(pitch)), overhang
     half = depth / 2.0
     z0, zr = -o * t, half * t
-    verts = np.array([
-        (-o, -o, z0), (width + o, -o, z0), (width + o, depth + o, z0), (-o, depth + o, z0),  # eaves
-        (half, half, zr), (width - half, half, zr),  # ridge (one point twice on a square)
-    ])
-    faces = np.array([(0, 1, 5), (0, 5, 4),  # front slope
-                      (1, 2, 5),  # right hip
-                      (2, 3, 4), (2, 4, 5),  # back slope
-                      (3, 0, 4)])  # left hip
+    verts = np.array(
+        [
+            (-o, -o, z0),
+            (width + o, -o, z0),
+            (width + o, depth + o, z0),
+            (-o, depth + o, z0),  # eaves
+            (half, half, zr),
+            (width - half, half, zr),  # ridge (one point twice on a square)
+        ]
+    )
+    faces = np.array(
+        [
+            (0, 1, 5),
+            (0, 5, 4),  # front slope
+            (1, 2, 5),  # right hip
+            (2, 3, 4),
+            (2, 4, 5),  # back slope
+            (3, 0, 4),
+        ]
+    )  # left hip
     if width - depth < 1e-12:  # a square: a pyramid, drop the two empty triangles
         faces = np.array([(0, 1, 4), (1, 2, 4), (2, 3, 4), (3, 0, 4)])
         verts = verts[:5]

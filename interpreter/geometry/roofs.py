@@ -174,11 +174,17 @@ class _Footprint:
         if signed_area(pts[keep]) < 0:  # clockwise: reverse, edge j now runs keep[j] -> keep[j+1]
             keep = keep[::-1]
             runs = [runs[j - 1] for j in range(len(runs) - 1, -1, -1)]
-        label = [max(run, key=lambda i: np.linalg.norm(pts[(i + 1) % count] - pts[i]))
-                 for run in runs]
+        label = [
+            max(run, key=lambda i: np.linalg.norm(pts[(i + 1) % count] - pts[i])) for run in runs
+        ]
         front = next(j for j, run in enumerate(runs) if 0 in run)
-        return cls(points=pts[keep], edges=[tuple(sorted(r)) for r in runs], label=label,
-                   front=front, scale=scale)
+        return cls(
+            points=pts[keep],
+            edges=[tuple(sorted(r)) for r in runs],
+            label=label,
+            front=front,
+            scale=scale,
+        )
 
 
 def _essential_corners(pts: np.ndarray, runs: list, tol: float):
@@ -258,9 +264,15 @@ class _MeshBuilder:
         vertices = self.vertices[used]
         if not np.isfinite(vertices).all():
             raise ArithmeticError("roof mesh has non-finite vertices")
-        return RoofMesh(vertices=vertices, faces=inverse.reshape(-1, 3).astype(np.int32),
-                        face_plane=owner, planes=self.planes,
-                        eave=np.asarray(eave, dtype=np.float64), overhang=overhang, kind=kind)
+        return RoofMesh(
+            vertices=vertices,
+            faces=inverse.reshape(-1, 3).astype(np.int32),
+            face_plane=owner,
+            planes=self.planes,
+            eave=np.asarray(eave, dtype=np.float64),
+            overhang=overhang,
+            kind=kind,
+        )
 
 
 def _unit(v) -> np.ndarray:
@@ -268,14 +280,21 @@ def _unit(v) -> np.ndarray:
     return v / np.linalg.norm(v)
 
 
-def _slope_plane(fp: _Footprint, k: int, tan: float, start: float = 0.0,
-                 base: float = 0.0) -> RoofPlane:
+def _slope_plane(
+    fp: _Footprint, k: int, tan: float, start: float = 0.0, base: float = 0.0
+) -> RoofPlane:
     """The plane over edge k that is at height ``base`` at inset ``start`` and rises at ``tan``."""
     _, nrm, _ = edge_lines(fp.points)
     normal = _unit([-tan * nrm[k][0], -tan * nrm[k][1], 1.0])
     point = np.append(fp.points[k] + start * nrm[k], base)
-    return RoofPlane("slope", fp.label[k], fp.edges[k], normal, float(normal @ point),
-                     math.degrees(math.atan(tan)))
+    return RoofPlane(
+        "slope",
+        fp.label[k],
+        fp.edges[k],
+        normal,
+        float(normal @ point),
+        math.degrees(math.atan(tan)),
+    )
 
 
 def _wall_plane(fp: _Footprint, k: int, kind: str, through) -> RoofPlane:
@@ -329,16 +348,21 @@ def _skeleton_roof(fp: _Footprint, kind: str, pitch: float, overhang: float) -> 
                 # an eave edge grown by the overhang rises from its wall top at z = 0; a gable
                 # that had to become a slope rises from the eave height instead
                 lower = overhang - overhang * weights[edge]
-                plane = builder.plane(("slope", edge, stage, lower), lambda: _slope_plane(
-                    fp, edge, tans[stage], inset * stage + lower, tans[0] * inset * stage))
+                plane = builder.plane(
+                    ("slope", edge, stage, lower),
+                    lambda: _slope_plane(
+                        fp, edge, tans[stage], inset * stage + lower, tans[0] * inset * stage
+                    ),
+                )
                 flat = sk.nodes[:, :2]
             else:
-                plane = builder.plane(("gable", edge),
-                                      lambda: _wall_plane(fp, edge, "gable", pts[edge]))
+                plane = builder.plane(
+                    ("gable", edge), lambda: _wall_plane(fp, edge, "gable", pts[edge])
+                )
                 flat = np.column_stack([sk.nodes[:, :2] @ d[k], sk.nodes[:, 2]])
             for cycle in cycles:
                 builder.add_polygon(cycle, flat[cycle], plane)
-    return builder.finish(builder.vertices[:len(eave)], overhang, kind)
+    return builder.finish(builder.vertices[: len(eave)], overhang, kind)
 
 
 def _gabled_skeleton(eave: np.ndarray, speed: np.ndarray, breaks) -> tuple[np.ndarray, Skeleton]:
@@ -355,9 +379,15 @@ def _gabled_skeleton(eave: np.ndarray, speed: np.ndarray, breaks) -> tuple[np.nd
     tol = 1e-6 * float(np.ptp(eave, axis=0).max())
     while True:
         sk = straight_skeleton(eave, speed, breaks)
-        astray = [k for k in np.flatnonzero(speed == 0)
-                  if any(np.abs(sk.nodes[cycle, :2] @ nrm[k] - c[k]).max() > tol
-                         for faces in sk.faces for cycle in faces[k])]
+        astray = [
+            k
+            for k in np.flatnonzero(speed == 0)
+            if any(
+                np.abs(sk.nodes[cycle, :2] @ nrm[k] - c[k]).max() > tol
+                for faces in sk.faces
+                for cycle in faces[k]
+            )
+        ]
         if not astray:
             return speed, sk
         speed[astray] = 1.0
@@ -371,8 +401,10 @@ def _gable_edges(fp: _Footprint, hip: Skeleton) -> list[int]:
     convex = _cross(np.roll(d, 1, axis=0), d) > 0  # at vertex i, between edges i-1 and i
     faces = hip.faces[0]
     xy = hip.nodes[:, :2]
-    sides = [{frozenset((c[i], c[(i + 1) % len(c)])) for c in cycles for i in range(len(c))}
-             for cycles in faces]
+    sides = [
+        {frozenset((c[i], c[(i + 1) % len(c)])) for c in cycles for i in range(len(c))}
+        for cycles in faces
+    ]
     min_ridge = 1e-6 * fp.scale
     chosen = []
     for k in range(n):
@@ -383,8 +415,9 @@ def _gable_edges(fp: _Footprint, hip: Skeleton) -> list[int]:
         if len(corners) != 3 or len(apex) != 1:
             continue
         shared = sides[k - 1] & sides[(k + 1) % n]
-        if any(apex[0] in s and np.linalg.norm(np.subtract(*xy[list(s)])) > min_ridge
-               for s in shared):
+        if any(
+            apex[0] in s and np.linalg.norm(np.subtract(*xy[list(s)])) > min_ridge for s in shared
+        ):
             chosen.append(k)
     if not chosen and n == 4 and convex.all():
         chosen = [(fp.front + 1) % 4, (fp.front + 3) % 4]
@@ -416,8 +449,10 @@ def _pyramid_apex(fp: _Footprint):
     def sees_all(p) -> bool:
         return bool(np.all(nrm @ p - c > margin))
 
-    candidates = [np.array(shape.centroid.coords[0]),
-                  np.array(polylabel(shape, 1e-4 * fp.scale).coords[0])]
+    candidates = [
+        np.array(shape.centroid.coords[0]),
+        np.array(polylabel(shape, 1e-4 * fp.scale).coords[0]),
+    ]
     seeing = [p for p in candidates if sees_all(p)]
     if seeing:  # the one farther from the boundary; the centroid on a tie (a rectangle)
         clearance = [shape.exterior.distance(Point(p)) for p in seeing]
@@ -470,9 +505,17 @@ def _pyramid_roof(fp: _Footprint, pitch: float, overhang: float, apex: np.ndarra
         a, b = np.append(pts[k], 0.0), np.append(pts[(k + 1) % n], 0.0)
         normal = _unit(np.cross(b - a, np.append(apex, height) - a))
         run = float(nrm[k] @ apex - c[k])  # horizontal distance from the edge to the apex
-        plane = builder.plane(k, lambda: RoofPlane("slope", fp.label[k], fp.edges[k], normal,
-                                                   float(normal @ a),
-                                                   math.degrees(math.atan2(height, run))))
+        plane = builder.plane(
+            k,
+            lambda: RoofPlane(
+                "slope",
+                fp.label[k],
+                fp.edges[k],
+                normal,
+                float(normal @ a),
+                math.degrees(math.atan2(height, run)),
+            ),
+        )
         builder.add([[k, (k + 1) % n, n]], plane)
     return builder.finish(eave, overhang, "pyramid")
 
@@ -494,8 +537,9 @@ def _shed_roof(fp: _Footprint, pitch: float, overhang: float) -> RoofMesh:
     bottom = float(top.min())
     low = top - bottom <= _CLEAN_TOL * fp.scale  # corners on the eave: one vertex, at the eave
     top[low] = bottom
-    vertices = np.vstack([np.column_stack([ring, top]),
-                          np.column_stack([ring, np.full(n, bottom)])])
+    vertices = np.vstack(
+        [np.column_stack([ring, top]), np.column_stack([ring, np.full(n, bottom)])]
+    )
     below = np.where(low, np.arange(n), np.arange(n) + n)
     builder = _MeshBuilder(vertices)
     roof = builder.plane("roof", lambda: _slope_plane(fp, f, tan, behind, 0.0))
@@ -516,7 +560,8 @@ def _flat_roof(fp: _Footprint, overhang: float) -> RoofMesh:
     ring, _ = _eave_ring(fp, overhang, np.ones(len(fp.points)))
     vertices = np.column_stack([ring, np.zeros(len(ring))])
     builder = _MeshBuilder(vertices)
-    plane = builder.plane("flat", lambda: RoofPlane("flat", None, (), np.array([0.0, 0.0, 1.0]),
-                                                    0.0, 0.0))
+    plane = builder.plane(
+        "flat", lambda: RoofPlane("flat", None, (), np.array([0.0, 0.0, 1.0]), 0.0, 0.0)
+    )
     builder.add_polygon(np.arange(len(ring)), ring, plane)
     return builder.finish(vertices, overhang, "flat")

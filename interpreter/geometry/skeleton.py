@@ -120,8 +120,9 @@ def straight_skeleton(polygon, weights=None, breaks=()) -> Skeleton:
     nodes[:, :2] = nodes[:, :2] * scale + centre
     nodes[:, 2] *= scale
     nodes[:n, :2] = pts  # the footprint's own corners, bit for bit
-    return Skeleton(nodes=nodes, faces=faces, weights=w, breaks=tuple(breaks),
-                    t_max=float(nodes[:, 2].max()))
+    return Skeleton(
+        nodes=nodes, faces=faces, weights=w, breaks=tuple(breaks), t_max=float(nodes[:, 2].max())
+    )
 
 
 def offset_outward(polygon, distance: float, weights=None):
@@ -213,8 +214,9 @@ class _Wavefront:
 
     def _vertex(self, p, t, e_in, e_out, node) -> _Vertex:
         v = _bisector_velocity(self.n[e_in], self.n[e_out], self.w[e_in], self.w[e_out])
-        return _Vertex(np.array(p, dtype=np.float64), t, np.zeros(2) if v is None else v,
-                       e_in, e_out, node)
+        return _Vertex(
+            np.array(p, dtype=np.float64), t, np.zeros(2) if v is None else v, e_in, e_out, node
+        )
 
     def _die(self, vx: _Vertex, node: int) -> None:
         """End the vertex's arc at ``node``: the arc bounds the faces of both its edges."""
@@ -275,8 +277,10 @@ class _Wavefront:
             for poly, ids in zip(polys, rings):
                 for q, vx in enumerate(poly):
                     self._segment(vx.e_out, ids[q], ids[(q + 1) % len(poly)])
-        return [[self._vertex(vx.p, time, vx.e_in, vx.e_out, nid) for vx, nid in zip(poly, ids)]
-                for poly, ids in zip(polys, rings)]
+        return [
+            [self._vertex(vx.p, time, vx.e_in, vx.e_out, nid) for vx, nid in zip(poly, ids)]
+            for poly, ids in zip(polys, rings)
+        ]
 
     @staticmethod
     def _advance(polys, time: float) -> None:
@@ -382,7 +386,7 @@ class _Wavefront:
         self._die(b, node)
         merged = self._vertex(mid, time, a.e_in, b.e_out, node)
         if j + 1 < m:
-            return poly[:j] + [merged] + poly[j + 2:]
+            return poly[:j] + [merged] + poly[j + 2 :]
         return poly[1:j] + [merged]
 
     def _split(self, poly, i: int, j: int, time: float):

@@ -7,7 +7,9 @@ from ..expressions import runtime_error
 
 def _channel(app, step, value) -> float:
     if isinstance(value, bool) or not isinstance(value, (int, float)) or not 0.0 <= value <= 1.0:
-        raise runtime_error(app.module, step.pos, f"a colour channel must be a number in 0..1, got {value!r}")
+        raise runtime_error(
+            app.module, step.pos, f"a colour channel must be a number in 0..1, got {value!r}"
+        )
     return float(value)
 
 
@@ -22,11 +24,15 @@ def color(app, shape, step, args) -> bool:
             shape.color = _PARSED[text]
             return False
         if not (isinstance(text, str) and len(text) == 7 and text[0] == "#"):
-            raise runtime_error(app.module, step.pos, f"{text!r} is not a colour", 'write "#rrggbb"')
+            raise runtime_error(
+                app.module, step.pos, f"{text!r} is not a colour", 'write "#rrggbb"'
+            )
         try:
-            shape.color = _PARSED[text] = tuple(int(text[i:i + 2], 16) / 255.0 for i in (1, 3, 5))
+            shape.color = _PARSED[text] = tuple(int(text[i : i + 2], 16) / 255.0 for i in (1, 3, 5))
         except ValueError:
-            raise runtime_error(app.module, step.pos, f"{text!r} is not a colour", 'write "#rrggbb"') from None
+            raise runtime_error(
+                app.module, step.pos, f"{text!r} is not a colour", 'write "#rrggbb"'
+            ) from None
     else:
         shape.color = tuple(_channel(app, step, v) for v in values)
     return False

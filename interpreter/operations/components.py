@@ -10,13 +10,21 @@ from bgr.grammar import nodes as n
 
 from ..expressions import runtime_error
 from ..geometry.meshes import PLANE_AXES
-from ..geometry.polygons import (RECT, UNIT_SQUARE, inset, is_unit_square, named_footprint,
-                                 normalise as normalise_polys, signed_area)
+from ..geometry.polygons import (
+    RECT,
+    UNIT_SQUARE,
+    inset,
+    is_unit_square,
+    named_footprint,
+    normalise as normalise_polys,
+    signed_area,
+)
 from ..shapes import Flat, Prism, Solid, cross, dot, normalise
 from ..terminals import UnitMesh
 
 
 # ---- comp(f) -----------------------------------------------------------------------------------
+
 
 def _faces(app, step, shape):
     """Faces of a shape as (points in scope-local metres, outward normal in scope coordinates)."""
@@ -24,8 +32,12 @@ def _faces(app, step, shape):
     if isinstance(geom, Solid) and geom.name == "cube":
         geom = Prism(1, RECT)
     if isinstance(geom, Solid):
-        raise runtime_error(app.module, step.pos, f"comp(f) of a '{geom.name}' shape is not supported",
-                            "comp(f) works on extruded shapes, boxes and 2D shapes")
+        raise runtime_error(
+            app.module,
+            step.pos,
+            f"comp(f) of a '{geom.name}' shape is not supported",
+            "comp(f) works on extruded shapes, boxes and 2D shapes",
+        )
     size = shape.size
     k = geom.k
     p, q = PLANE_AXES[k]
@@ -39,8 +51,17 @@ def _faces(app, step, shape):
     up = [0.0, 0.0, 0.0]
     up[k] = 1.0
     if isinstance(geom, Flat):
-        return [([[point(u, v, 0) for u, v in ext], *[[point(u, v, 0) for u, v in h] for h in holes]], up,
-                 (0.0, 0.0)) for ext, holes in polys]
+        return [
+            (
+                [
+                    [point(u, v, 0) for u, v in ext],
+                    *[[point(u, v, 0) for u, v in h] for h in holes],
+                ],
+                up,
+                (0.0, 0.0),
+            )
+            for ext, holes in polys
+        ]
     faces = []
     for ext, holes in polys:
         for ring, is_hole in [(ext, False)] + [(h, True) for h in holes]:
@@ -56,14 +77,36 @@ def _faces(app, step, shape):
                 nrm = normalise(cross(edge, up) if outward_right else cross(up, edge))
                 if dot(edge, edge) < 1e-18:
                     continue
-                faces.append(([[a, b, point(u1, v1, 1), point(u0, v0, 1)]], nrm, (turns[i], turns[(i + 1) % n])))
+                faces.append(
+                    (
+                        [[a, b, point(u1, v1, 1), point(u0, v0, 1)]],
+                        nrm,
+                        (turns[i], turns[(i + 1) % n]),
+                    )
+                )
     down = [-c for c in up]
     for ext, holes in polys:
-        faces.append(([[point(u, v, 1) for u, v in ext], *[[point(u, v, 1) for u, v in h] for h in holes]], up,
-                      (0.0, 0.0)))
+        faces.append(
+            (
+                [
+                    [point(u, v, 1) for u, v in ext],
+                    *[[point(u, v, 1) for u, v in h] for h in holes],
+                ],
+                up,
+                (0.0, 0.0),
+            )
+        )
     for ext, holes in polys:
-        faces.append(([[point(u, v, 0) for u, v in ext], *[[point(u, v, 0) for u, v in h] for h in holes]], down,
-                      (0.0, 0.0)))
+        faces.append(
+            (
+                [
+                    [point(u, v, 0) for u, v in ext],
+                    *[[point(u, v, 0) for u, v in h] for h in holes],
+                ],
+                down,
+                (0.0, 0.0),
+            )
+        )
     return faces
 
 
@@ -75,7 +118,9 @@ def _turns(ring, outer_sign: int) -> list[float]:
     for i in range(n):
         (ax, ay), (bx, by), (cx, cy) = ring[i - 1], ring[i], ring[(i + 1) % n]
         d1, d2 = (bx - ax, by - ay), (cx - bx, cy - by)
-        angle = math.degrees(math.atan2(d1[0] * d2[1] - d1[1] * d2[0], d1[0] * d2[0] + d1[1] * d2[1]))
+        angle = math.degrees(
+            math.atan2(d1[0] * d2[1] - d1[1] * d2[0], d1[0] * d2[0] + d1[1] * d2[1])
+        )
         out.append(0.0 if abs(angle) < 1e-9 else outer_sign * angle)
     return out
 
@@ -120,7 +165,10 @@ def _face_shape(shape, rings, nrm):
     w, h = max(xs) - x0, max(ys) - y0
     plane = dot(rings[0][0], z)
     origin_local = [x0 * x[i] + y0 * y[i] + plane * z[i] for i in range(3)]
-    unit = [tuple(((cx - x0) / (w or 1.0), (cy - y0) / (h or 1.0)) for cx, cy in ring) for ring in coords]
+    unit = [
+        tuple(((cx - x0) / (w or 1.0), (cy - y0) / (h or 1.0)) for cx, cy in ring)
+        for ring in coords
+    ]
     polys = [(unit[0], tuple(unit[1:]))]
     face = shape.copy().cut_from(shape)
     face.origin = shape.world(origin_local)
@@ -142,7 +190,9 @@ def comp(app, shape, step, args) -> bool:
     kinds = [_classify(nrm) for _, nrm, _ in faces]
     taken = [False] * len(faces)
     for entry in step.block.entries:
-        chosen = [i for i in range(len(faces)) if not taken[i] and _matches(app, entry.key, kinds[i], i)]
+        chosen = [
+            i for i in range(len(faces)) if not taken[i] and _matches(app, entry.key, kinds[i], i)
+        ]
         for i in chosen:
             taken[i] = True
         for j, i in enumerate(chosen):
@@ -155,11 +205,14 @@ def comp(app, shape, step, args) -> bool:
 
 # ---- offset ------------------------------------------------------------------------------------
 
+
 def offset(app, shape, step, args) -> bool:
     distance = args[0]
     geom = shape.geom
     if not isinstance(geom, Flat):
-        raise runtime_error(app.module, step.pos, "offset() needs a 2D shape", "use it on a face from comp(f)")
+        raise runtime_error(
+            app.module, step.pos, "offset() needs a 2D shape", "use it on a face from comp(f)"
+        )
     p, q = PLANE_AXES[geom.k]
     polys = [(UNIT_SQUARE, ())] if geom.polys == RECT else geom.polys
     inside, border = inset(polys, shape.size[p], shape.size[q], float(distance))
@@ -182,10 +235,15 @@ def offset(app, shape, step, args) -> bool:
 
 # ---- extrude and taper -------------------------------------------------------------------------
 
+
 def _flat(app, step, shape) -> Flat:
     if not isinstance(shape.geom, Flat):
-        raise runtime_error(app.module, step.pos, f"{step.name}() needs a 2D shape, and this one is already 3D",
-                            "extrude a lot or a face (from comp(f)), not a mass")
+        raise runtime_error(
+            app.module,
+            step.pos,
+            f"{step.name}() needs a 2D shape, and this one is already 3D",
+            "extrude a lot or a face (from comp(f)), not a mass",
+        )
     return shape.geom
 
 
@@ -193,8 +251,12 @@ def _height(app, step, value) -> float:
     if isinstance(value, bool) or not isinstance(value, (int, float)):
         raise runtime_error(app.module, step.pos, f"{step.name}() needs a number, got {value!r}")
     if value < 0:
-        raise runtime_error(app.module, step.pos, f"negative height {value:g} in {step.name}()",
-                            "heights are lengths; use r() to turn a shape over")
+        raise runtime_error(
+            app.module,
+            step.pos,
+            f"negative height {value:g} in {step.name}()",
+            "heights are lengths; use r() to turn a shape over",
+        )
     return float(value)
 
 
@@ -204,20 +266,27 @@ def footprint(app, shape, step, args) -> bool:
     kind, a, b = args[0], args[1], args[2]
     for name, value in (("a", a), ("b", b)):
         if isinstance(value, bool) or not isinstance(value, (int, float)):
-            raise runtime_error(app.module, step.pos, f"footprint() needs a number for {name}, got {value!r}")
+            raise runtime_error(
+                app.module, step.pos, f"footprint() needs a number for {name}, got {value!r}"
+            )
     if kind == "circle":
         sides = 24 if len(step.args) < 2 else a
         if sides != int(sides) or not 3 <= sides <= 1024:
-            raise runtime_error(app.module, step.pos, f"a circle footprint needs 3 to 1024 sides, got {sides:g}")
+            raise runtime_error(
+                app.module, step.pos, f"a circle footprint needs 3 to 1024 sides, got {sides:g}"
+            )
         a = sides
     else:
         b = a if len(step.args) < 3 else b
         for name, value in (("a", a), ("b", b)):
             most = 0.5 if kind == "U" and name == "a" else 1.0  # U's two wings must not meet
             if kind != "rect" and not 0 < value < most:
-                raise runtime_error(app.module, step.pos,
-                                    f"footprint({kind}) needs 0 < {name} < {most:g} (a fraction of the scope), "
-                                    f"got {value:g}")
+                raise runtime_error(
+                    app.module,
+                    step.pos,
+                    f"footprint({kind}) needs 0 < {name} < {most:g} (a fraction of the scope), "
+                    f"got {value:g}",
+                )
     polys = named_footprint(kind, a, b)
     shape.geom = Flat(geom.k, RECT if kind == "rect" else polys)
     return False
@@ -254,7 +323,9 @@ def taper(app, shape, step, args) -> bool:
         for ring in [ext, *holes]:
             for a, b in zip(ring, ring[1:] + ring[:1]):
                 quad2 = np.array([a, b, b, a], dtype=float)
-                lifted = np.vstack([_lift(quad2[:2], k, 0.0), _lift(centre + (quad2[2:] - centre) * ratio, k, 1.0)])
+                lifted = np.vstack(
+                    [_lift(quad2[:2], k, 0.0), _lift(centre + (quad2[2:] - centre) * ratio, k, 1.0)]
+                )
                 mid3 = _lift(middle[None, :2], k, 0.5)[0]
                 quad_faces = _orient(lifted, np.array([[0, 1, 2], [0, 2, 3]]), lambda c: c - mid3)
                 verts.append(lifted)

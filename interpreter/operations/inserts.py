@@ -47,8 +47,9 @@ def _load_asset(app, step, module, asset):
     if path in cache:
         return cache[path]
     if not path.is_file():
-        raise runtime_error(module, asset.pos, f"asset file '{asset.path}' not found",
-                            f"looked for {path}")
+        raise runtime_error(
+            module, asset.pos, f"asset file '{asset.path}' not found", f"looked for {path}"
+        )
     try:
         import trimesh
 

@@ -16,15 +16,25 @@ def roof(app, shape, step, args) -> bool:
     kind, pitch, overhang = args[0], args[1], args[2]
     geom = shape.geom
     if not isinstance(geom, Flat):
-        raise runtime_error(app.module, step.pos, "roof() needs a 2D footprint",
-                            "use it on a lot or on the top face from comp(f)")
+        raise runtime_error(
+            app.module,
+            step.pos,
+            "roof() needs a 2D footprint",
+            "use it on a lot or on the top face from comp(f)",
+        )
     for what, value in (("pitch", pitch), ("overhang", overhang)):
         if isinstance(value, bool) or not isinstance(value, (int, float)):
-            raise runtime_error(app.module, step.pos, f"the roof's {what} must be a number, got {value!r}")
+            raise runtime_error(
+                app.module, step.pos, f"the roof's {what} must be a number, got {value!r}"
+            )
     if kind != "flat" and not 0 < pitch < 90:
-        raise runtime_error(app.module, step.pos, f"a roof pitch must lie between 0 and 90 degrees, got {pitch:g}")
+        raise runtime_error(
+            app.module, step.pos, f"a roof pitch must lie between 0 and 90 degrees, got {pitch:g}"
+        )
     if overhang < 0:
-        raise runtime_error(app.module, step.pos, f"a negative overhang ({overhang:g}) is not a roof")
+        raise runtime_error(
+            app.module, step.pos, f"a negative overhang ({overhang:g}) is not a roof"
+        )
     from ..geometry.roofs import roof_mesh
 
     k = geom.k
@@ -41,7 +51,9 @@ def roof(app, shape, step, args) -> bool:
         try:
             m = roof_mesh(np.asarray(ext, dtype=float), kind, float(pitch), float(overhang))
         except ValueError as e:  # a footprint the roof builder cannot use (not simple, degenerate)
-            raise runtime_error(app.module, step.pos, f"cannot build a {kind} roof on this footprint: {e}") from None
+            raise runtime_error(
+                app.module, step.pos, f"cannot build a {kind} roof on this footprint: {e}"
+            ) from None
         verts.append(m.vertices)
         faces.append(m.faces + base)
         base += len(m.vertices)

@@ -17,6 +17,7 @@ from ..geometry.polygons import RECT, clip, renormalise
 from ..shapes import Prism, Solid
 from ..split_solver import Piece, Repeat, solve
 
+
 def _sizes(app, entries) -> tuple:
     """The evaluated sizes of a block's entries (a nested tuple for repeat groups): with the
     block and the length, all the placement depends on, so it keys the solver's memo."""
@@ -27,15 +28,21 @@ def _sizes(app, entries) -> tuple:
             continue
         size = app.value(entry.key)
         if isinstance(size, bool) or not isinstance(size, (int, float)) or not math.isfinite(size):
-            raise runtime_error(app.module, entry.pos, f"a split size must be a finite number, got {size!r}")
+            raise runtime_error(
+                app.module, entry.pos, f"a split size must be a finite number, got {size!r}"
+            )
         out.append(float(size))
     return tuple(out)
 
 
 def _items(entries, sizes: tuple) -> tuple:
     """The solver's items for those sizes (built only when the memo misses)."""
-    return tuple(Repeat(_items(entry.entries, size)) if isinstance(entry, n.Group)
-                 else Piece(entry.kind, size, entry) for entry, size in zip(entries, sizes))
+    return tuple(
+        Repeat(_items(entry.entries, size))
+        if isinstance(entry, n.Group)
+        else Piece(entry.kind, size, entry)
+        for entry, size in zip(entries, sizes)
+    )
 
 
 def _clip(app, step, geom, axis: int, lo: float, hi: float):
@@ -43,8 +50,12 @@ def _clip(app, step, geom, axis: int, lo: float, hi: float):
     if isinstance(geom, Solid):
         if geom.name == "cube":
             return geom
-        raise runtime_error(app.module, step.pos, f"split of a '{geom.name}' shape is not supported",
-                            "split the footprint or the faces (comp(f)) instead of the solid")
+        raise runtime_error(
+            app.module,
+            step.pos,
+            f"split of a '{geom.name}' shape is not supported",
+            "split the footprint or the faces (comp(f)) instead of the solid",
+        )
     if axis == geom.k:
         return geom if isinstance(geom, Prism) else None
     if geom.polys == RECT:

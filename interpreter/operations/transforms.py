@@ -29,8 +29,12 @@ def translate(app, shape, step, args) -> bool:
 def scale(app, shape, step, args) -> bool:
     size = _amounts(app, step, shape, args[:3])
     if min(size) < 0:
-        raise runtime_error(app.module, step.pos, f"negative size {min(size):g} in s()",
-                            "sizes are lengths; flip a shape with r() instead")
+        raise runtime_error(
+            app.module,
+            step.pos,
+            f"negative size {min(size):g} in s()",
+            "sizes are lengths; flip a shape with r() instead",
+        )
     shape.size = size
     return False
 
@@ -84,7 +88,9 @@ def matrix(app, shape, step, args) -> bool:
     y = normalise([cols[1][k] - dot(cols[1], x) * x[k] for k in range(3)])
     z = cross(x, y)
     if dot(z, cols[2]) < 0:
-        raise runtime_error(app.module, step.pos, "matrix() mirrors the scope; scopes stay right-handed")
+        raise runtime_error(
+            app.module, step.pos, "matrix() mirrors the scope; scopes stay right-handed"
+        )
     new_origin = shape.world(offset)
     shape.axes = tuple(tuple(shape.direction(v)) for v in (x, y, z))
     shape.origin = new_origin

@@ -36,8 +36,16 @@ FORMATS = {
 EXTENSIONS = {f".{name}": name for name in FORMATS}
 NOT_YET = {".city.json": "CityJSON output is not implemented yet"}
 
-__all__ = ["write", "write_json", "to_trimesh", "read_glb", "bake", "format_of", "FORMATS",
-           "EXTENSIONS"]
+__all__ = [
+    "write",
+    "write_json",
+    "to_trimesh",
+    "read_glb",
+    "bake",
+    "format_of",
+    "FORMATS",
+    "EXTENSIONS",
+]
 
 
 def _known() -> str:
@@ -57,12 +65,18 @@ def format_of(path: Path, fmt: str | None = None) -> str:
             raise BgrError(Diagnostic(str(path), 0, 0, why, _known()))
     suffix = Path(lower).suffix
     if suffix not in EXTENSIONS:
-        shown = f"unknown output extension '{suffix}'" if suffix else "the output file name has no extension"
+        shown = (
+            f"unknown output extension '{suffix}'"
+            if suffix
+            else "the output file name has no extension"
+        )
         raise BgrError(Diagnostic(str(path), 0, 0, shown, _known()))
     return EXTENSIONS[suffix]
 
 
-def write(table: TerminalTable, path: Path, *, seed: int, attrs: dict, fmt: str | None = None) -> None:
+def write(
+    table: TerminalTable, path: Path, *, seed: int, attrs: dict, fmt: str | None = None
+) -> None:
     """Write ``table`` to ``path`` in the format of its extension, or ``fmt`` when given.
 
     ``path`` ``"-"`` writes to standard output and needs ``fmt`` (not ``obj``, which is two files).
@@ -77,7 +91,9 @@ def write(table: TerminalTable, path: Path, *, seed: int, attrs: dict, fmt: str 
         if name == "json":
             write_json(table, sys.stdout, seed=seed, attrs=attrs)
         elif name == "obj":
-            raise BgrError("obj cannot go to standard output (it comes with a .mtl file); give a file name")
+            raise BgrError(
+                "obj cannot go to standard output (it comes with a .mtl file); give a file name"
+            )
         else:
             sys.stdout.flush()
             FORMATS[name](table, sys.stdout.buffer, seed=seed, attrs=attrs)

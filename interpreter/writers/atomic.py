@@ -22,7 +22,9 @@ def _open_temp(target: Path) -> tuple[Path, BinaryIO]:
         tmp = folder / f".{target.name}.{secrets.token_hex(4)}.tmp"
         try:
             # mode 0o666 lets the umask decide the permissions, as for any new file
-            fd = os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_EXCL | getattr(os, "O_BINARY", 0), 0o666)
+            fd = os.open(
+                tmp, os.O_WRONLY | os.O_CREAT | os.O_EXCL | getattr(os, "O_BINARY", 0), 0o666
+            )
         except FileExistsError:
             continue
         return tmp, os.fdopen(fd, "wb")
@@ -36,7 +38,10 @@ def _remove(path: Path) -> None:
 
 def cannot_write(target: Path, exc: OSError) -> BgrError:
     if isinstance(exc, FileNotFoundError) and not target.parent.is_dir():
-        reason, hint = f"the folder {target.parent} does not exist", "create it first, or check the path"
+        reason, hint = (
+            f"the folder {target.parent} does not exist",
+            "create it first, or check the path",
+        )
     else:
         reason, hint = exc.strerror or str(exc), None
     return BgrError(Diagnostic(str(target), 0, 0, f"cannot write the output file: {reason}", hint))

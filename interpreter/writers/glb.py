@@ -32,8 +32,16 @@ import numpy as np
 from ...grammar.errors import BgrError
 from ..terminals import TerminalTable
 from .materials import Materials, materials_of
-from .meshes import (MeshPool, bounds, det3, face_offsets, orthonormal, place_corners, shape_order,
-                     unit_normals)
+from .meshes import (
+    MeshPool,
+    bounds,
+    det3,
+    face_offsets,
+    orthonormal,
+    place_corners,
+    shape_order,
+    unit_normals,
+)
 from .terminal_json import plain
 
 INSTANCING = "EXT_mesh_gpu_instancing"
@@ -49,10 +57,14 @@ GROUP_OVERHEAD = 1000
 class Plan:
     baked: np.ndarray  # terminal rows baked to world space: by material, mesh shape, table order
     groups: list[tuple[int, int, np.ndarray]]  # instanced (mesh id, material, rows in table order)
-    scale: np.ndarray  # (N, 3) instance scales: the size, with 1 on axes where the mesh is flat at 0
+    scale: (
+        np.ndarray
+    )  # (N, 3) instance scales: the size, with 1 on axes where the mesh is flat at 0
 
 
-def plan(table: TerminalTable, pool: MeshPool, mats: Materials, instancing: str | bool = "auto") -> Plan:
+def plan(
+    table: TerminalTable, pool: MeshPool, mats: Materials, instancing: str | bool = "auto"
+) -> Plan:
     """Which terminals to instance.
 
     A terminal can be instanced when its axes are orthonormal and right-handed (the rotation is a
@@ -84,7 +96,9 @@ def plan(table: TerminalTable, pool: MeshPool, mats: Materials, instancing: str 
     if instancing is True or instancing == "always":
         chosen = keys
     else:
-        chosen = keys[(counts >= 2) & (stored + counts * INSTANCE_BYTES + GROUP_OVERHEAD < counts * stored)]
+        chosen = keys[
+            (counts >= 2) & (stored + counts * INSTANCE_BYTES + GROUP_OVERHEAD < counts * stored)
+        ]
 
     instanced = eligible & np.isin(key, chosen)
     groups = []
@@ -116,20 +130,48 @@ def quaternions(axes: np.ndarray) -> np.ndarray:
         a, b, c = r[:, 0, 0], r[:, 1, 1], r[:, 2, 2]
         if case == 0:
             s = np.sqrt(1.0 + a + b + c) * 2
-            q[sel] = np.stack([(r[:, 2, 1] - r[:, 1, 2]) / s, (r[:, 0, 2] - r[:, 2, 0]) / s,
-                               (r[:, 1, 0] - r[:, 0, 1]) / s, 0.25 * s], axis=1)
+            q[sel] = np.stack(
+                [
+                    (r[:, 2, 1] - r[:, 1, 2]) / s,
+                    (r[:, 0, 2] - r[:, 2, 0]) / s,
+                    (r[:, 1, 0] - r[:, 0, 1]) / s,
+                    0.25 * s,
+                ],
+                axis=1,
+            )
         elif case == 1:
             s = np.sqrt(1.0 + a - b - c) * 2
-            q[sel] = np.stack([0.25 * s, (r[:, 0, 1] + r[:, 1, 0]) / s,
-                               (r[:, 0, 2] + r[:, 2, 0]) / s, (r[:, 2, 1] - r[:, 1, 2]) / s], axis=1)
+            q[sel] = np.stack(
+                [
+                    0.25 * s,
+                    (r[:, 0, 1] + r[:, 1, 0]) / s,
+                    (r[:, 0, 2] + r[:, 2, 0]) / s,
+                    (r[:, 2, 1] - r[:, 1, 2]) / s,
+                ],
+                axis=1,
+            )
         elif case == 2:
             s = np.sqrt(1.0 + b - a - c) * 2
-            q[sel] = np.stack([(r[:, 0, 1] + r[:, 1, 0]) / s, 0.25 * s,
-                               (r[:, 1, 2] + r[:, 2, 1]) / s, (r[:, 0, 2] - r[:, 2, 0]) / s], axis=1)
+            q[sel] = np.stack(
+                [
+                    (r[:, 0, 1] + r[:, 1, 0]) / s,
+                    0.25 * s,
+                    (r[:, 1, 2] + r[:, 2, 1]) / s,
+                    (r[:, 0, 2] - r[:, 2, 0]) / s,
+                ],
+                axis=1,
+            )
         else:
             s = np.sqrt(1.0 + c - a - b) * 2
-            q[sel] = np.stack([(r[:, 0, 2] + r[:, 2, 0]) / s, (r[:, 1, 2] + r[:, 2, 1]) / s,
-                               0.25 * s, (r[:, 1, 0] - r[:, 0, 1]) / s], axis=1)
+            q[sel] = np.stack(
+                [
+                    (r[:, 0, 2] + r[:, 2, 0]) / s,
+                    (r[:, 1, 2] + r[:, 2, 1]) / s,
+                    0.25 * s,
+                    (r[:, 1, 0] - r[:, 0, 1]) / s,
+                ],
+                axis=1,
+            )
     q /= np.linalg.norm(q, axis=1, keepdims=True)
     q[q[:, 3] < 0] *= -1
     return q
@@ -145,32 +187,43 @@ class _Builder:
         self.accessors: list[dict] = []
         self._data: list[np.ndarray] = []
 
-    def view(self, count: int, width: int, target: int | None = ARRAY_BUFFER) -> tuple[int, np.ndarray]:
+    def view(
+        self, count: int, width: int, target: int | None = ARRAY_BUFFER
+    ) -> tuple[int, np.ndarray]:
         """Reserve ``count`` float32 VEC<width>: the bufferView's index and an array to fill."""
         length = count * width * 4  # a multiple of 4, so every view stays 4-byte aligned
         view = {"buffer": 0, "byteOffset": self.offset, "byteLength": length}
         if target is not None:
             view["target"] = target
         self.views.append(view)
-        data = self.bin[self.offset:self.offset + length].view("<f4").reshape(count, width)
+        data = self.bin[self.offset : self.offset + length].view("<f4").reshape(count, width)
         self._data.append(data)
         self.offset += length
         return len(self.views) - 1, data
 
-    def accessor(self, view: int, first: int = 0, count: int | None = None, bounded: bool = False) -> int:
+    def accessor(
+        self, view: int, first: int = 0, count: int | None = None, bounded: bool = False
+    ) -> int:
         """An accessor on elements ``first:first + count`` of a view; with min/max if ``bounded``."""
         data = self._data[view]
         count = len(data) - first if count is None else count
-        acc = {"bufferView": view, "componentType": FLOAT, "count": count, "type": f"VEC{data.shape[1]}"}
+        acc = {
+            "bufferView": view,
+            "componentType": FLOAT,
+            "count": count,
+            "type": f"VEC{data.shape[1]}",
+        }
         if first:
             acc["byteOffset"] = first * data.shape[1] * 4
         if bounded:
-            lo, hi = bounds(data[first:first + count])
+            lo, hi = bounds(data[first : first + count])
             acc["min"], acc["max"] = [float(v) for v in lo], [float(v) for v in hi]
         self.accessors.append(acc)
         return len(self.accessors) - 1
 
-    def vec(self, values: np.ndarray, target: int | None = ARRAY_BUFFER, bounded: bool = False) -> int:
+    def vec(
+        self, values: np.ndarray, target: int | None = ARRAY_BUFFER, bounded: bool = False
+    ) -> int:
         """A view and its accessor holding ``values`` (n, width)."""
         view, data = self.view(len(values), values.shape[1], target)
         data[:] = values
@@ -185,7 +238,9 @@ def recentre(table: TerminalTable, limit: float = 4096.0) -> np.ndarray:
     return np.round((table.origin.min(axis=0) + table.origin.max(axis=0)) / 2) + 0.0
 
 
-def build(table: TerminalTable, *, seed: int, attrs: dict, instancing: str | bool = "auto") -> tuple[dict, np.ndarray]:
+def build(
+    table: TerminalTable, *, seed: int, attrs: dict, instancing: str | bool = "auto"
+) -> tuple[dict, np.ndarray]:
     """The glTF JSON document and its binary buffer (uint8) for a table."""
     table.freeze()
     pool = MeshPool.of(table)
@@ -206,39 +261,67 @@ def build(table: TerminalTable, *, seed: int, attrs: dict, instancing: str | boo
     if n_corner:
         pos_view, pos_data = b.view(n_corner, 3)
         nrm_view, nrm_data = b.view(n_corner, 3)
-        place_corners(table, p.baked, pool, pos_data.reshape(-1, 3, 3), nrm_data.reshape(-1, 3, 3), shift)
+        place_corners(
+            table, p.baked, pool, pos_data.reshape(-1, 3, 3), nrm_data.reshape(-1, 3, 3), shift
+        )
         mat_of_row = mats.index[p.baked]
         cuts = np.flatnonzero(np.diff(mat_of_row)) + 1
         prims = []
         for lo, hi in zip(np.concatenate([[0], cuts]), np.concatenate([cuts, [len(mat_of_row)]])):
             first, count = 3 * int(fstart[lo]), 3 * int(fstart[hi] - fstart[lo])
             if count:
-                prims.append({"attributes": {"POSITION": b.accessor(pos_view, first, count, bounded=True),
-                                             "NORMAL": b.accessor(nrm_view, first, count)},
-                              "material": int(mat_of_row[lo]), "mode": 4})
+                prims.append(
+                    {
+                        "attributes": {
+                            "POSITION": b.accessor(pos_view, first, count, bounded=True),
+                            "NORMAL": b.accessor(nrm_view, first, count),
+                        },
+                        "material": int(mat_of_row[lo]),
+                        "mode": 4,
+                    }
+                )
         meshes.append({"name": "terminals", "primitives": prims})
         nodes.append({"name": "terminals", "mesh": 0, **place})
 
     # instanced groups: the unit mesh once, one node with per-instance TRS
     names = [m.name for m in table.library.meshes]
     for mesh_id, mat, rows in p.groups:
-        unit = pool.vertices[pool.voff[mesh_id]:pool.voff[mesh_id] + pool.vcount[mesh_id]]
-        corners = unit[pool.faces[pool.foff[mesh_id]:pool.foff[mesh_id] + pool.fcount[mesh_id]]]
+        unit = pool.vertices[pool.voff[mesh_id] : pool.voff[mesh_id] + pool.vcount[mesh_id]]
+        corners = unit[pool.faces[pool.foff[mesh_id] : pool.foff[mesh_id] + pool.fcount[mesh_id]]]
         normals = unit_normals(corners, fallback=(0.0, 0.0, 1.0))
         pos = b.vec(corners.reshape(-1, 3), bounded=True)
         nrm = b.vec(np.repeat(normals, 3, axis=0))
-        trs = {"TRANSLATION": b.vec(table.origin[rows] - shift, None),
-               "ROTATION": b.vec(quaternions(table.axes[rows]), None),
-               "SCALE": b.vec(p.scale[rows], None)}
+        trs = {
+            "TRANSLATION": b.vec(table.origin[rows] - shift, None),
+            "ROTATION": b.vec(quaternions(table.axes[rows]), None),
+            "SCALE": b.vec(p.scale[rows], None),
+        }
         name = f"{names[mesh_id]} {mats.labels[mat]}"
-        meshes.append({"name": name, "primitives": [
-            {"attributes": {"POSITION": pos, "NORMAL": nrm}, "material": mat, "mode": 4}]})
-        nodes.append({"name": name, "mesh": len(meshes) - 1, **place,
-                      "extensions": {INSTANCING: {"attributes": trs}}})
+        meshes.append(
+            {
+                "name": name,
+                "primitives": [
+                    {"attributes": {"POSITION": pos, "NORMAL": nrm}, "material": mat, "mode": 4}
+                ],
+            }
+        )
+        nodes.append(
+            {
+                "name": name,
+                "mesh": len(meshes) - 1,
+                **place,
+                "extensions": {INSTANCING: {"attributes": trs}},
+            }
+        )
     assert b.offset == nbytes
 
-    gltf: dict = {"asset": {"version": "2.0", "generator": f"bgr {_version()}",
-                            "extras": {"bgr": 1, "seed": seed, "attrs": attrs}}}
+    gltf: dict = {
+        "asset": {
+            "version": "2.0",
+            "generator": f"bgr {_version()}",
+            "extras": {"bgr": 1, "seed": seed, "attrs": attrs},
+        }
+    }
     if p.groups:
         gltf["extensionsUsed"] = [INSTANCING]
     gltf["scene"] = 0
@@ -248,12 +331,18 @@ def build(table: TerminalTable, *, seed: int, attrs: dict, instancing: str | boo
         gltf["meshes"] = meshes
     if len(mats):
         gltf["materials"] = [
-            {"name": mats.labels[k],
-             "pbrMetallicRoughness": {"baseColorFactor": mats.linear(k) + [1.0],
-                                      "metallicFactor": 0.0, "roughnessFactor": 0.8},
-             "doubleSided": True,
-             "extras": {"color": mats.hex(k), "material": mats.names[k]}}
-            for k in range(len(mats))]
+            {
+                "name": mats.labels[k],
+                "pbrMetallicRoughness": {
+                    "baseColorFactor": mats.linear(k) + [1.0],
+                    "metallicFactor": 0.0,
+                    "roughnessFactor": 0.8,
+                },
+                "doubleSided": True,
+                "extras": {"color": mats.hex(k), "material": mats.names[k]},
+            }
+            for k in range(len(mats))
+        ]
     if b.accessors:
         gltf["accessors"] = b.accessors
         gltf["bufferViews"] = b.views
@@ -273,13 +362,21 @@ def _version() -> str:
 def _json_bytes(gltf: dict, **layout) -> bytes:
     layout = layout or {"separators": (",", ":")}
     try:
-        return json.dumps(gltf, ensure_ascii=False, allow_nan=False, default=plain, **layout).encode("utf-8")
+        return json.dumps(
+            gltf, ensure_ascii=False, allow_nan=False, default=plain, **layout
+        ).encode("utf-8")
     except (TypeError, ValueError) as exc:
         raise BgrError(f"cannot write glTF: {exc}") from exc
 
 
-def write_glb(table: TerminalTable, stream: BinaryIO, *, seed: int, attrs: dict,
-              instancing: str | bool = "auto") -> None:
+def write_glb(
+    table: TerminalTable,
+    stream: BinaryIO,
+    *,
+    seed: int,
+    attrs: dict,
+    instancing: str | bool = "auto",
+) -> None:
     """A binary glTF: header, JSON chunk (space-padded), BIN chunk.  ``instancing``: see :func:`plan`."""
     gltf, bin_ = build(table, seed=seed, attrs=attrs, instancing=instancing)
     text = _json_bytes(gltf)
@@ -293,11 +390,18 @@ def write_glb(table: TerminalTable, stream: BinaryIO, *, seed: int, attrs: dict,
         stream.write(c if isinstance(c, bytes) else memoryview(c))
 
 
-def write_gltf(table: TerminalTable, stream: BinaryIO, *, seed: int, attrs: dict,
-               instancing: str | bool = "auto") -> None:
+def write_gltf(
+    table: TerminalTable,
+    stream: BinaryIO,
+    *,
+    seed: int,
+    attrs: dict,
+    instancing: str | bool = "auto",
+) -> None:
     """One self-contained .gltf: JSON with the buffer as a base64 data URI."""
     gltf, bin_ = build(table, seed=seed, attrs=attrs, instancing=instancing)
     if bin_.nbytes:
-        gltf["buffers"][0]["uri"] = ("data:application/octet-stream;base64,"
-                                     + base64.b64encode(bin_.tobytes()).decode("ascii"))
+        gltf["buffers"][0]["uri"] = "data:application/octet-stream;base64," + base64.b64encode(
+            bin_.tobytes()
+        ).decode("ascii")
     stream.write(_json_bytes(gltf, indent=1) + b"\n")

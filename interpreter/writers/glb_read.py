@@ -27,15 +27,17 @@ def parse(data: bytes) -> tuple[dict, bytes]:
     if data[:4] == b"glTF":
         _, version, length = struct.unpack_from("<4sII", data)
         if version != 2 or length != len(data):
-            raise BgrError(f"not a glTF 2.0 binary (version {version}, length {length} of {len(data)})")
+            raise BgrError(
+                f"not a glTF 2.0 binary (version {version}, length {length} of {len(data)})"
+            )
         json_len, _ = struct.unpack_from("<II", data, 12)
-        gltf = json.loads(data[20:20 + json_len])
+        gltf = json.loads(data[20 : 20 + json_len])
         at = 20 + json_len
         blob = b""
         if at + 8 <= len(data):
             bin_len, kind = struct.unpack_from("<II", data, at)
             if kind == 0x004E4942:
-                blob = data[at + 8:at + 8 + bin_len]
+                blob = data[at + 8 : at + 8 + bin_len]
         return gltf, blob
     gltf = json.loads(data)
     uri = gltf.get("buffers", [{}])[0].get("uri", "") if gltf.get("buffers") else ""
@@ -63,11 +65,14 @@ def accessor(gltf: dict, blob: bytes, index: int) -> np.ndarray:
 def quat_matrix(q: np.ndarray) -> np.ndarray:
     """(n, 3, 3) rotation matrices of (n, 4) quaternions (x, y, z, w)."""
     x, y, z, w = (q / np.linalg.norm(q, axis=1, keepdims=True)).T
-    return np.stack([
-        np.stack([1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)], axis=1),
-        np.stack([2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)], axis=1),
-        np.stack([2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)], axis=1),
-    ], axis=1)
+    return np.stack(
+        [
+            np.stack([1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)], axis=1),
+            np.stack([2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)], axis=1),
+            np.stack([2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)], axis=1),
+        ],
+        axis=1,
+    )
 
 
 def _trs(t, r, s) -> np.ndarray:
@@ -82,9 +87,11 @@ def _trs(t, r, s) -> np.ndarray:
 def _node_matrix(node: dict) -> np.ndarray:
     if "matrix" in node:
         return np.array(node["matrix"], dtype=np.float64).reshape(4, 4).T  # column-major
-    return _trs(np.array([node.get("translation", [0, 0, 0])], dtype=np.float64),
-                np.array([node.get("rotation", [0, 0, 0, 1])], dtype=np.float64),
-                np.array([node.get("scale", [1, 1, 1])], dtype=np.float64))[0]
+    return _trs(
+        np.array([node.get("translation", [0, 0, 0])], dtype=np.float64),
+        np.array([node.get("rotation", [0, 0, 0, 1])], dtype=np.float64),
+        np.array([node.get("scale", [1, 1, 1])], dtype=np.float64),
+    )[0]
 
 
 def _to_srgb(linear) -> np.ndarray:
@@ -95,7 +102,11 @@ def _to_srgb(linear) -> np.ndarray:
 def read_glb(path: Path | str) -> trimesh.Trimesh:
     """World-space triangles of every node of the default scene, with per-face colours."""
     gltf, blob = parse(Path(path).read_bytes())
-    nodes, meshes, materials = gltf.get("nodes", []), gltf.get("meshes", []), gltf.get("materials", [])
+    nodes, meshes, materials = (
+        gltf.get("nodes", []),
+        gltf.get("meshes", []),
+        gltf.get("materials", []),
+    )
     verts, faces, colours = [], [], []
     count = 0
 
@@ -108,8 +119,16 @@ def read_glb(path: Path | str) -> trimesh.Trimesh:
             if inst:
                 a = inst["attributes"]
                 n = gltf["accessors"][next(iter(a.values()))]["count"]
-                t = accessor(gltf, blob, a["TRANSLATION"]) if "TRANSLATION" in a else np.zeros((n, 3))
-                r = accessor(gltf, blob, a["ROTATION"]) if "ROTATION" in a else np.tile([0.0, 0, 0, 1], (n, 1))
+                t = (
+                    accessor(gltf, blob, a["TRANSLATION"])
+                    if "TRANSLATION" in a
+                    else np.zeros((n, 3))
+                )
+                r = (
+                    accessor(gltf, blob, a["ROTATION"])
+                    if "ROTATION" in a
+                    else np.tile([0.0, 0, 0, 1], (n, 1))
+                )
                 s = accessor(gltf, blob, a["SCALE"]) if "SCALE" in a else np.ones((n, 3))
                 placements = world @ _trs(t, r, s)
             else:
@@ -118,8 +137,11 @@ def read_glb(path: Path | str) -> trimesh.Trimesh:
                 if prim.get("mode", 4) != 4:
                     continue
                 pos = accessor(gltf, blob, prim["attributes"]["POSITION"])
-                tri = (accessor(gltf, blob, prim["indices"]).reshape(-1, 3) if "indices" in prim
-                       else np.arange(len(pos)).reshape(-1, 3))
+                tri = (
+                    accessor(gltf, blob, prim["indices"]).reshape(-1, 3)
+                    if "indices" in prim
+                    else np.arange(len(pos)).reshape(-1, 3)
+                )
                 placed = pos @ placements[:, :3, :3].transpose(0, 2, 1) + placements[:, None, :3, 3]
                 flip = np.linalg.det(placements[:, :3, :3]) < 0
                 tris = np.broadcast_to(tri, (len(placements),) + tri.shape).copy()
@@ -130,8 +152,11 @@ def read_glb(path: Path | str) -> trimesh.Trimesh:
                 count += len(placements) * len(pos)
                 factor = [1.0, 1.0, 1.0, 1.0]
                 if "material" in prim:
-                    factor = materials[prim["material"]].get("pbrMetallicRoughness", {}).get(
-                        "baseColorFactor", factor)
+                    factor = (
+                        materials[prim["material"]]
+                        .get("pbrMetallicRoughness", {})
+                        .get("baseColorFactor", factor)
+                    )
                 rgba = np.append(np.rint(_to_srgb(factor[:3]) * 255), np.rint(factor[3] * 255))
                 colours.append(np.tile(rgba.astype(np.uint8), (len(tris) * len(tri), 1)))
         for child in node.get("children", []):
@@ -146,5 +171,9 @@ def read_glb(path: Path | str) -> trimesh.Trimesh:
         visit(root, np.eye(4))
     if not faces:
         return trimesh.Trimesh(np.zeros((0, 3)), np.zeros((0, 3), dtype=np.int64), process=False)
-    return trimesh.Trimesh(np.concatenate(verts), np.concatenate(faces),
-                           face_colors=np.concatenate(colours), process=False)
+    return trimesh.Trimesh(
+        np.concatenate(verts),
+        np.concatenate(faces),
+        face_colors=np.concatenate(colours),
+        process=False,
+    )

@@ -42,7 +42,9 @@ def materials_of(table: TerminalTable) -> Materials:
     if len(name_ids) <= 1:
         names_col = np.zeros(len(table), dtype=np.int64)
     else:
-        names_col = np.fromiter(map(name_ids.__getitem__, table.material), dtype=np.int64, count=len(table))
+        names_col = np.fromiter(
+            map(name_ids.__getitem__, table.material), dtype=np.int64, count=len(table)
+        )
     key = (names_col << 24) | packed
     uniq, first, inverse = np.unique(key, return_index=True, return_inverse=True)
     order = np.argsort(first, kind="stable")  # materials in order of first use

@@ -33,8 +33,8 @@ class MeshPool:
         meshes = table.library.meshes
         verts = [m.vertices for m in meshes] or [np.zeros((0, 3))]
         faces = [m.faces for m in meshes] or [np.zeros((0, 3), dtype=np.int64)]
-        vcount = np.fromiter(map(len, verts), dtype=np.int64, count=len(verts))[:len(meshes)]
-        fcount = np.fromiter(map(len, faces), dtype=np.int64, count=len(faces))[:len(meshes)]
+        vcount = np.fromiter(map(len, verts), dtype=np.int64, count=len(verts))[: len(meshes)]
+        fcount = np.fromiter(map(len, faces), dtype=np.int64, count=len(faces))[: len(meshes)]
         return cls(
             vertices=np.concatenate(verts).astype(np.float64, copy=False),
             faces=np.concatenate(faces).astype(np.int64, copy=False),
@@ -90,10 +90,14 @@ def bounds(points: np.ndarray, block: int = 1024) -> tuple[np.ndarray, np.ndarra
     """Per-column min and max of (n, 3) points; blocked so numpy reduces long contiguous rows."""
     k = len(points) // block * block
     head = points[:k].reshape(-1, block * 3)
-    lo = np.minimum(head.min(axis=0, initial=np.inf).reshape(block, 3).min(axis=0),
-                    points[k:].min(axis=0, initial=np.inf))
-    hi = np.maximum(head.max(axis=0, initial=-np.inf).reshape(block, 3).max(axis=0),
-                    points[k:].max(axis=0, initial=-np.inf))
+    lo = np.minimum(
+        head.min(axis=0, initial=np.inf).reshape(block, 3).min(axis=0),
+        points[k:].min(axis=0, initial=np.inf),
+    )
+    hi = np.maximum(
+        head.max(axis=0, initial=-np.inf).reshape(block, 3).max(axis=0),
+        points[k:].max(axis=0, initial=-np.inf),
+    )
     return lo, hi
 
 
@@ -107,11 +111,15 @@ class Baked:
     fstart: np.ndarray  # (n + 1,) face offsets per row
 
 
-def bake(table: TerminalTable, rows: np.ndarray | None = None, pool: MeshPool | None = None) -> Baked:
+def bake(
+    table: TerminalTable, rows: np.ndarray | None = None, pool: MeshPool | None = None
+) -> Baked:
     """World vertices and faces of the terminals ``rows`` (default: all), concatenated in order."""
     table.freeze()
     pool = pool or MeshPool.of(table)
-    rows = np.arange(len(table), dtype=np.int64) if rows is None else np.asarray(rows, dtype=np.int64)
+    rows = (
+        np.arange(len(table), dtype=np.int64) if rows is None else np.asarray(rows, dtype=np.int64)
+    )
     mesh = table.mesh[rows].astype(np.int64)
     nv, nf = pool.vcount[mesh], pool.fcount[mesh]
     vstart = np.concatenate([[0], np.cumsum(nv)]).astype(np.int64)
@@ -164,7 +172,9 @@ def unit_normals(tri: np.ndarray, fallback=(0.0, 1.0, 0.0)) -> np.ndarray:
     return n
 
 
-def shape_order(table: TerminalTable, rows: np.ndarray, pool: MeshPool, major: np.ndarray) -> np.ndarray:
+def shape_order(
+    table: TerminalTable, rows: np.ndarray, pool: MeshPool, major: np.ndarray
+) -> np.ndarray:
     """``rows`` sorted by ``major`` (e.g. material), then mesh shape, then table order: the order
     in which :func:`place_corners` writes whole blocks instead of scattering triangles."""
     mesh = table.mesh[rows]
@@ -173,8 +183,14 @@ def shape_order(table: TerminalTable, rows: np.ndarray, pool: MeshPool, major: n
     return rows[np.lexsort((rows, shape, major))]
 
 
-def place_corners(table: TerminalTable, rows: np.ndarray, pool: MeshPool, positions: np.ndarray,
-                  normals: np.ndarray, shift: np.ndarray | None = None) -> None:
+def place_corners(
+    table: TerminalTable,
+    rows: np.ndarray,
+    pool: MeshPool,
+    positions: np.ndarray,
+    normals: np.ndarray,
+    shift: np.ndarray | None = None,
+) -> None:
     """Flat-shaded triangles of the terminals ``rows``, in float32, written in place.
 
     ``positions`` and ``normals`` are (T, 3, 3) float32 arrays (T = total triangles, rows in
@@ -188,7 +204,11 @@ def place_corners(table: TerminalTable, rows: np.ndarray, pool: MeshPool, positi
     mesh = table.mesh[rows].astype(np.int64)
     fstart = face_offsets(table, rows, pool)
     origin = table.origin[rows] if shift is None else table.origin[rows] - shift
-    origin, axes, size = origin.astype(f32), table.axes[rows].astype(f32), table.size[rows].astype(f32)
+    origin, axes, size = (
+        origin.astype(f32),
+        table.axes[rows].astype(f32),
+        table.size[rows].astype(f32),
+    )
     flip = mirrored(table, rows)
     vpool = pool.vertices.astype(f32)
 
@@ -197,7 +217,7 @@ def place_corners(table: TerminalTable, rows: np.ndarray, pool: MeshPool, positi
         m = mesh[sel]
         if m[0] == m[-1] and (m == m[0]).all():  # one shared unit mesh
             lo = pool.foff[m[0]]
-            unit = vpool[pool.faces[lo:lo + F].reshape(-1) + pool.voff[m[0]]]
+            unit = vpool[pool.faces[lo : lo + F].reshape(-1) + pool.voff[m[0]]]
             local = unit[None] * size[sel][:, None, :]
         else:
             idx = pool.faces[pool.foff[m][:, None] + np.arange(F)] + pool.voff[m][:, None, None]

@@ -32,12 +32,13 @@ def obj_names(mats: Materials) -> list[str]:
 
 def _rows(stream: BinaryIO, fmt: str, values: np.ndarray) -> None:
     for lo in range(0, len(values), _CHUNK):
-        part = values[lo:lo + _CHUNK]
+        part = values[lo : lo + _CHUNK]
         stream.write(((fmt * len(part)) % tuple(part.ravel().tolist())).encode("ascii"))
 
 
-def write_obj(table: TerminalTable, stream: BinaryIO, mtl: BinaryIO, *, mtl_name: str,
-              seed: int, attrs: dict) -> None:
+def write_obj(
+    table: TerminalTable, stream: BinaryIO, mtl: BinaryIO, *, mtl_name: str, seed: int, attrs: dict
+) -> None:
     table.freeze()
     mats = materials_of(table)
     names = obj_names(mats)
@@ -54,6 +55,13 @@ def write_obj(table: TerminalTable, stream: BinaryIO, mtl: BinaryIO, *, mtl_name
     lines = ["# bgr materials"]
     for k, name in enumerate(names):
         r, g, b = (c / 255.0 for c in mats.rgb8[k])
-        lines += [f"newmtl {name}", f"Kd {r:.6g} {g:.6g} {b:.6g}", "Ka 0 0 0", "Ks 0 0 0",
-                  "d 1", "illum 1", ""]
+        lines += [
+            f"newmtl {name}",
+            f"Kd {r:.6g} {g:.6g} {b:.6g}",
+            "Ka 0 0 0",
+            "Ks 0 0 0",
+            "d 1",
+            "illum 1",
+            "",
+        ]
     mtl.write("\n".join(lines).encode("utf-8"))

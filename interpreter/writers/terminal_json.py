@@ -74,8 +74,16 @@ def terminal_dicts(table: TerminalTable) -> list[dict]:
                 "geometry": geometry,
             }
             for label, rule, path, o, a, sz, c, material, geometry in zip(
-                table.label, table.rule, table.path, origin, axes, size, colours, table.material,
-                table.geometry_names())
+                table.label,
+                table.rule,
+                table.path,
+                origin,
+                axes,
+                size,
+                colours,
+                table.material,
+                table.geometry_names(),
+            )
         ]
 
 
@@ -86,7 +94,9 @@ def dumps(table: TerminalTable, *, seed: int, attrs: dict) -> str:
 
 
 def _document(table: TerminalTable, seed: int, attrs: dict) -> str:
-    head = f'{{\n  "bgr": 1,\n  "seed": {_dumps(seed)},\n  "attrs": {_dumps(attrs)},\n  "terminals": ['
+    head = (
+        f'{{\n  "bgr": 1,\n  "seed": {_dumps(seed)},\n  "attrs": {_dumps(attrs)},\n  "terminals": ['
+    )
     rows = ",\n".join(["    " + _dumps(t) for t in terminal_dicts(table)])
     lots = ",\n".join(["    " + _dumps(lot) for lot in table.lots])
     tail = ',\n  "lots": [\n' + lots + "\n  ]\n}\n" if lots else "\n}\n"

@@ -50,8 +50,15 @@ def read_model(source, *, fixed: dict[str, bool] | None = None, seed: int = 0, l
     try:
         text = path.read_text(encoding="utf-8")
     except FileNotFoundError:
-        raise BgrError(Diagnostic(shown, 0, 0, "no such file", "give a terminal list (bgr derive -o x.json), "
-                                  "a captured-model .json or a .bgr")) from None
+        raise BgrError(
+            Diagnostic(
+                shown,
+                0,
+                0,
+                "no such file",
+                "give a terminal list (bgr derive -o x.json), a captured-model .json or a .bgr",
+            )
+        ) from None
     except (OSError, UnicodeDecodeError) as exc:
         raise BgrError(Diagnostic(shown, 0, 0, f"cannot read the file: {exc}")) from None
     from .captured import parse  # strict JSON: line and column, duplicate keys, no NaN
@@ -68,9 +75,16 @@ def _from_dict(data, shown: str, fixed) -> Model:
         from .captured import model_from_captured
 
         return model_from_captured(data, shown, fixed)
-    raise BgrError(Diagnostic(shown, 0, 0, "neither a terminal list nor a captured model",
-                              "a terminal list has a 'terminals' list (bgr derive -o x.json); a captured "
-                              "model has 'bgr_captured' and 'blocks' (docs/inverse-schema.md)"))
+    raise BgrError(
+        Diagnostic(
+            shown,
+            0,
+            0,
+            "neither a terminal list nor a captured model",
+            "a terminal list has a 'terminals' list (bgr derive -o x.json); a captured "
+            "model has 'bgr_captured' and 'blocks' (docs/inverse-schema.md)",
+        )
+    )
 
 
 def infer(source, *, fixed: dict[str, bool] | None = None, seed: int = 0, lot=None) -> n.Module:

@@ -52,98 +52,174 @@ SCHEMA: dict = {
     "$schema": "https://json-schema.org/draft/2020-12/schema",
     "title": "bgr captured model",
     "description": "A building captured by hand, Build-by-Number style: blocks (box, cylinder, prism) in a "
-                   "scene graph, cut into floors, each face of each floor subdivided into labelled subfaces. "
-                   "See docs/inverse-schema.md, section 'Captured-model JSON'.",
+    "scene graph, cut into floors, each face of each floor subdivided into labelled subfaces. "
+    "See docs/inverse-schema.md, section 'Captured-model JSON'.",
     "type": "object",
     "required": ["bgr_captured", "blocks"],
     "additionalProperties": False,
     "properties": {
-        "bgr_captured": {"const": FORMAT_VERSION,
-                         "description": "the format version: 1 (the only one)"},
+        "bgr_captured": {
+            "const": FORMAT_VERSION,
+            "description": "the format version: 1 (the only one)",
+        },
         "name": {"type": "string", "description": "the building's name, free text"},
         "labels": {
             "type": "object",
             "description": "per label, whether its size is fixed (windows, doors) or stretches (brick); "
-                           "labels not listed are fixed when they contain window, door, entrance, entry, "
-                           "portal or gate",
+            "labels not listed are fixed when they contain window, door, entrance, entry, "
+            "portal or gate",
             "propertyNames": {"$ref": "#/$defs/label"},
             "additionalProperties": {"$ref": "#/$defs/labelInfo"},
         },
-        "blocks": {"type": "array", "minItems": 1, "items": {"$ref": "#/$defs/block"},
-                   "description": "the building blocks, at least one"},
+        "blocks": {
+            "type": "array",
+            "minItems": 1,
+            "items": {"$ref": "#/$defs/block"},
+            "description": "the building blocks, at least one",
+        },
     },
     "$defs": {
-        "length": {"type": "number", "exclusiveMinimum": 0, "maximum": MAX_LENGTH,
-                   "description": "a length in metres, greater than 0 (and at most 1e6)"},
-        "coordinate": {"type": "number", "minimum": -MAX_LENGTH, "maximum": MAX_LENGTH,
-                       "description": "a coordinate in metres (between -1e6 and 1e6)"},
-        "label": {"type": "string", "pattern": IDENTIFIER,
-                  "description": "a label: an identifier (letters, digits and _, not starting with a digit), "
-                                 "as it names a terminal of the inferred grammar"},
+        "length": {
+            "type": "number",
+            "exclusiveMinimum": 0,
+            "maximum": MAX_LENGTH,
+            "description": "a length in metres, greater than 0 (and at most 1e6)",
+        },
+        "coordinate": {
+            "type": "number",
+            "minimum": -MAX_LENGTH,
+            "maximum": MAX_LENGTH,
+            "description": "a coordinate in metres (between -1e6 and 1e6)",
+        },
+        "label": {
+            "type": "string",
+            "pattern": IDENTIFIER,
+            "description": "a label: an identifier (letters, digits and _, not starting with a digit), "
+            "as it names a terminal of the inferred grammar",
+        },
         "labelInfo": {
-            "type": "object", "required": ["fixed"], "additionalProperties": False,
-            "properties": {"fixed": {"type": "boolean",
-                                     "description": "true: keeps its size on a novel face; false: stretches"}},
-            "description": "a label's properties: {\"fixed\": true|false}",
+            "type": "object",
+            "required": ["fixed"],
+            "additionalProperties": False,
+            "properties": {
+                "fixed": {
+                    "type": "boolean",
+                    "description": "true: keeps its size on a novel face; false: stretches",
+                }
+            },
+            "description": 'a label\'s properties: {"fixed": true|false}',
         },
         "block": {
             "type": "object",
-            "description": "a block: {\"id\", \"shape\", \"size\": [width, height, depth], ...}",
+            "description": 'a block: {"id", "shape", "size": [width, height, depth], ...}',
             "required": ["id", "shape", "size"],
             "additionalProperties": False,
             "properties": {
-                "id": {"type": "string", "minLength": 1,
-                       "description": "the block's id, unique in the file"},
-                "shape": {"enum": ["box", "cylinder", "prism"],
-                          "description": "the block's solid: box, cylinder or prism"},
-                "size": {"type": "array", "items": _LENGTH, "minItems": 3, "maxItems": 3,
-                         "description": "[width, height, depth] in metres: the block's extent along its "
-                                        "local x, y (up) and z"},
-                "sides": {"type": "integer", "minimum": 3, "maximum": 360,
-                          "description": "a cylinder's number of facets, 3 to 360"},
-                "footprint": {"type": "array", "minItems": 3, "maxItems": 1000,
-                              "items": {"type": "array", "items": _COORD, "minItems": 2, "maxItems": 2,
-                                        "description": "a footprint point [x, z] in metres"},
-                              "description": "a prism's plan: [[x, z], ...] in metres in the block's frame, "
-                                             "at least 3 points, not closed (the last is not the first again)"},
+                "id": {
+                    "type": "string",
+                    "minLength": 1,
+                    "description": "the block's id, unique in the file",
+                },
+                "shape": {
+                    "enum": ["box", "cylinder", "prism"],
+                    "description": "the block's solid: box, cylinder or prism",
+                },
+                "size": {
+                    "type": "array",
+                    "items": _LENGTH,
+                    "minItems": 3,
+                    "maxItems": 3,
+                    "description": "[width, height, depth] in metres: the block's extent along its "
+                    "local x, y (up) and z",
+                },
+                "sides": {
+                    "type": "integer",
+                    "minimum": 3,
+                    "maximum": 360,
+                    "description": "a cylinder's number of facets, 3 to 360",
+                },
+                "footprint": {
+                    "type": "array",
+                    "minItems": 3,
+                    "maxItems": 1000,
+                    "items": {
+                        "type": "array",
+                        "items": _COORD,
+                        "minItems": 2,
+                        "maxItems": 2,
+                        "description": "a footprint point [x, z] in metres",
+                    },
+                    "description": "a prism's plan: [[x, z], ...] in metres in the block's frame, "
+                    "at least 3 points, not closed (the last is not the first again)",
+                },
                 "transform": {
-                    "type": "object", "additionalProperties": False,
-                    "description": "{\"translate\": [x, y, z], \"rotate\": degrees about y}, relative to the parent",
+                    "type": "object",
+                    "additionalProperties": False,
+                    "description": '{"translate": [x, y, z], "rotate": degrees about y}, relative to the parent',
                     "properties": {
-                        "translate": {"type": "array", "items": _COORD, "minItems": 3, "maxItems": 3,
-                                      "description": "[x, y, z] in metres, in the parent's frame"},
-                        "rotate": {"type": "number", "minimum": -360, "maximum": 360,
-                                   "description": "degrees about the vertical (y) axis, -360 to 360; "
-                                                  "positive turns +x toward -z"},
+                        "translate": {
+                            "type": "array",
+                            "items": _COORD,
+                            "minItems": 3,
+                            "maxItems": 3,
+                            "description": "[x, y, z] in metres, in the parent's frame",
+                        },
+                        "rotate": {
+                            "type": "number",
+                            "minimum": -360,
+                            "maximum": 360,
+                            "description": "degrees about the vertical (y) axis, -360 to 360; "
+                            "positive turns +x toward -z",
+                        },
                     },
                 },
-                "parent": {"type": ["string", "null"],
-                           "description": "the id of the block this one's transform is relative to, or null"},
-                "attach": {"type": "array", "items": {"$ref": "#/$defs/attach"},
-                           "description": "the faces of this block that touch faces of other blocks"},
-                "floors": {"type": "array", "minItems": 1, "items": {"$ref": "#/$defs/floor"},
-                           "description": "the block's floors, bottom to top; their heights sum to the "
-                                          "block's height"},
-                "faces": {"type": "object",
-                          "additionalProperties": {"type": "array", "minItems": 1,
-                                                   "items": {"$ref": "#/$defs/subface"},
-                                                   "description": "one subface per floor, bottom to top"},
-                          "description": "per face name (box: front, right, back, left; cylinder and "
-                                         "prism: \"0\", \"1\", ...), one subface per floor"},
+                "parent": {
+                    "type": ["string", "null"],
+                    "description": "the id of the block this one's transform is relative to, or null",
+                },
+                "attach": {
+                    "type": "array",
+                    "items": {"$ref": "#/$defs/attach"},
+                    "description": "the faces of this block that touch faces of other blocks",
+                },
+                "floors": {
+                    "type": "array",
+                    "minItems": 1,
+                    "items": {"$ref": "#/$defs/floor"},
+                    "description": "the block's floors, bottom to top; their heights sum to the "
+                    "block's height",
+                },
+                "faces": {
+                    "type": "object",
+                    "additionalProperties": {
+                        "type": "array",
+                        "minItems": 1,
+                        "items": {"$ref": "#/$defs/subface"},
+                        "description": "one subface per floor, bottom to top",
+                    },
+                    "description": "per face name (box: front, right, back, left; cylinder and "
+                    'prism: "0", "1", ...), one subface per floor',
+                },
                 "plain": {"$ref": "#/$defs/label"},
                 "roof": {"$ref": "#/$defs/label"},
             },
             "allOf": [
-                {"if": {"properties": {"shape": {"const": "cylinder"}}, "required": ["shape"]},
-                 "then": {"required": ["sides"]}},
-                {"if": {"properties": {"shape": {"const": "prism"}}, "required": ["shape"]},
-                 "then": {"required": ["footprint"]}},
+                {
+                    "if": {"properties": {"shape": {"const": "cylinder"}}, "required": ["shape"]},
+                    "then": {"required": ["sides"]},
+                },
+                {
+                    "if": {"properties": {"shape": {"const": "prism"}}, "required": ["shape"]},
+                    "then": {"required": ["footprint"]},
+                },
             ],
         },
         "attach": {
-            "type": "object", "required": ["face", "to", "to_face"], "additionalProperties": False,
-            "description": "an attachment: {\"face\": this block's face, \"to\": another block's id, "
-                           "\"to_face\": that block's face}",
+            "type": "object",
+            "required": ["face", "to", "to_face"],
+            "additionalProperties": False,
+            "description": 'an attachment: {"face": this block\'s face, "to": another block\'s id, '
+            '"to_face": that block\'s face}',
             "properties": {
                 "face": {"type": "string", "description": "a face of this block"},
                 "to": {"type": "string", "description": "the id of another block"},
@@ -151,34 +227,52 @@ SCHEMA: dict = {
             },
         },
         "floor": {
-            "type": "object", "required": ["height"], "additionalProperties": False,
-            "description": "a floor: {\"name\": ..., \"height\": metres}",
+            "type": "object",
+            "required": ["height"],
+            "additionalProperties": False,
+            "description": 'a floor: {"name": ..., "height": metres}',
             "properties": {
-                "name": {"type": "string", "minLength": 1, "description": "the floor's name (base, ground, ...)"},
+                "name": {
+                    "type": "string",
+                    "minLength": 1,
+                    "description": "the floor's name (base, ground, ...)",
+                },
                 "height": _LENGTH,
             },
         },
         "subface": {
-            "type": "object", "additionalProperties": False,
-            "description": "a subface: a leaf {\"label\", \"size\", \"occluded\"} or a subdivision "
-                           "{\"label\" (optional), \"size\", \"split\": \"x\"|\"y\", \"parts\": [...]}",
+            "type": "object",
+            "additionalProperties": False,
+            "description": 'a subface: a leaf {"label", "size", "occluded"} or a subdivision '
+            '{"label" (optional), "size", "split": "x"|"y", "parts": [...]}',
             "properties": {
                 "label": {"$ref": "#/$defs/label"},
                 "size": _LENGTH,
-                "occluded": {"type": "boolean",
-                             "description": "true when the photographs do not show this subface"},
-                "split": {"enum": ["x", "y"],
-                          "description": "the axis of the subdivision: x (columns, left to right) or "
-                                         "y (rows, bottom to top)"},
-                "parts": {"type": "array", "minItems": 1, "items": {"$ref": "#/$defs/part"},
-                          "description": "the parts of the subdivision, left to right or bottom to top"},
+                "occluded": {
+                    "type": "boolean",
+                    "description": "true when the photographs do not show this subface",
+                },
+                "split": {
+                    "enum": ["x", "y"],
+                    "description": "the axis of the subdivision: x (columns, left to right) or "
+                    "y (rows, bottom to top)",
+                },
+                "parts": {
+                    "type": "array",
+                    "minItems": 1,
+                    "items": {"$ref": "#/$defs/part"},
+                    "description": "the parts of the subdivision, left to right or bottom to top",
+                },
             },
             "dependentRequired": {"split": ["parts"], "parts": ["split"]},
             "if": {"not": {"required": ["split"]}},
             "then": {"required": ["label"]},
         },
-        "part": {"$ref": "#/$defs/subface", "required": ["size"],
-                 "description": "a part of a subdivision: a subface with its size along the split axis"},
+        "part": {
+            "$ref": "#/$defs/subface",
+            "required": ["size"],
+            "description": "a part of a subdivision: a subface with its size along the split axis",
+        },
     },
 }
 
@@ -189,6 +283,7 @@ def schema_text() -> str:
 
 
 # ---- errors -----------------------------------------------------------------------------------
+
 
 def _diag(path: str, where: str, message: str, hint: str | None = None) -> Diagnostic:
     text = f"{where}: {message}" if where else message
@@ -228,8 +323,15 @@ def _num(x: float) -> str:
     return format(x, ".12g")
 
 
-_KIND = {dict: "an object", list: "an array", str: "a string", bool: "a boolean", type(None): "null",
-         int: "a number", float: "a number"}
+_KIND = {
+    dict: "an object",
+    list: "an array",
+    str: "a string",
+    bool: "a boolean",
+    type(None): "null",
+    int: "a number",
+    float: "a number",
+}
 
 
 def _kind(value) -> str:
@@ -237,6 +339,7 @@ def _kind(value) -> str:
 
 
 # ---- stage 1: the JSON itself -------------------------------------------------------------------
+
 
 class _Object(dict):
     """A JSON object that remembers the keys given more than once."""
@@ -267,13 +370,22 @@ def parse(text: str, path: str = "<captured>"):
     except json.JSONDecodeError as exc:
         lines = text.split("\n")
         line = lines[exc.lineno - 1] if 0 < exc.lineno <= len(lines) else None
-        raise BgrError(Diagnostic(path, exc.lineno, exc.colno, f"not valid JSON: {exc.msg}",
-                                  "a captured model is a JSON object: {\"bgr_captured\": 1, \"blocks\": [...]}",
-                                  source_line=line)) from None
+        raise BgrError(
+            Diagnostic(
+                path,
+                exc.lineno,
+                exc.colno,
+                f"not valid JSON: {exc.msg}",
+                'a captured model is a JSON object: {"bgr_captured": 1, "blocks": [...]}',
+                source_line=line,
+            )
+        ) from None
     except ValueError as exc:  # NaN, Infinity; integers too long to convert
         raise _error(path, "", f"not valid JSON: {exc}") from None
     except RecursionError:
-        raise _error(path, "", f"the JSON is nested too deeply (more than {MAX_NESTING} levels)") from None
+        raise _error(
+            path, "", f"the JSON is nested too deeply (more than {MAX_NESTING} levels)"
+        ) from None
 
 
 def _check_json(data, path: str) -> list[Diagnostic]:
@@ -288,8 +400,14 @@ def _check_json(data, path: str) -> list[Diagnostic]:
             continue
         if isinstance(value, dict):
             for key in getattr(value, "duplicates", ()):
-                out.append(_diag(path, _join(where, key), "given twice in one object",
-                                 "JSON keeps only the last one; remove the other"))
+                out.append(
+                    _diag(
+                        path,
+                        _join(where, key),
+                        "given twice in one object",
+                        "JSON keeps only the last one; remove the other",
+                    )
+                )
             items = []
             for key, item in value.items():
                 if not isinstance(key, str):
@@ -298,12 +416,14 @@ def _check_json(data, path: str) -> list[Diagnostic]:
                 items.append((item, _join(where, key), depth + 1))
             stack.extend(reversed(items))
         elif isinstance(value, list):
-            stack.extend(reversed([(item, _join(where, i), depth + 1) for i, item in enumerate(value)]))
+            stack.extend(
+                reversed([(item, _join(where, i), depth + 1) for i, item in enumerate(value)])
+            )
         elif isinstance(value, float):
             if not math.isfinite(value):
                 out.append(_diag(path, where, f"{value} is not a JSON number"))
         elif isinstance(value, int) and not isinstance(value, bool):
-            if abs(value) > 10 ** 300:
+            if abs(value) > 10**300:
                 out.append(_diag(path, where, "a number too large to be a length or a coordinate"))
         elif not isinstance(value, (str, bool)) and value is not None:
             out.append(_diag(path, where, f"{type(value).__name__} is not a JSON value"))
@@ -321,8 +441,15 @@ def _validator():
         try:
             from jsonschema import Draft202012Validator
         except ImportError:  # pragma: no cover - a declared dependency
-            raise BgrError(Diagnostic("", 0, 0, "reading a captured model needs the jsonschema package",
-                                      "pip install jsonschema")) from None
+            raise BgrError(
+                Diagnostic(
+                    "",
+                    0,
+                    0,
+                    "reading a captured model needs the jsonschema package",
+                    "pip install jsonschema",
+                )
+            ) from None
         _VALIDATOR = Draft202012Validator(SCHEMA)
     return _VALIDATOR
 
@@ -368,7 +495,9 @@ def _schema_diagnostics(error, path: str) -> list[Diagnostic]:
         out = []
         for key in instance:
             if key not in known:
-                hint = suggest(key, known) or ("expected one of: " + ", ".join(known) if known else None)
+                hint = suggest(key, known) or (
+                    "expected one of: " + ", ".join(known) if known else None
+                )
                 out.append(_diag(path, _join(where, key), "unknown key", hint))
         return out
     if kind == "dependentRequired" and isinstance(instance, dict):
@@ -377,22 +506,47 @@ def _schema_diagnostics(error, path: str) -> list[Diagnostic]:
             if key in instance:
                 for other in needs:
                     if other not in instance:
-                        out.append(_diag(path, _join(where, other), f"missing: a subface with \"{key}\" "
-                                         f"needs \"{other}\"", _expected(SCHEMA["$defs"]["subface"])))
+                        out.append(
+                            _diag(
+                                path,
+                                _join(where, other),
+                                f'missing: a subface with "{key}" needs "{other}"',
+                                _expected(SCHEMA["$defs"]["subface"]),
+                            )
+                        )
         return out
     if kind == "type":
         types = value if isinstance(value, list) else [value]
-        words = " or ".join({"object": "an object", "array": "an array", "string": "a string",
-                             "number": "a number", "integer": "an integer", "boolean": "true or false",
-                             "null": "null"}.get(t, t) for t in types)
-        return [_diag(path, where, f"expected {words}, got {_kind(instance)} {_show(instance)}", hint)]
+        words = " or ".join(
+            {
+                "object": "an object",
+                "array": "an array",
+                "string": "a string",
+                "number": "a number",
+                "integer": "an integer",
+                "boolean": "true or false",
+                "null": "null",
+            }.get(t, t)
+            for t in types
+        )
+        return [
+            _diag(path, where, f"expected {words}, got {_kind(instance)} {_show(instance)}", hint)
+        ]
     if kind == "enum":
-        return [_diag(path, where, f"{_show(instance)} is not one of {', '.join(map(str, value))}", hint)]
+        return [
+            _diag(
+                path, where, f"{_show(instance)} is not one of {', '.join(map(str, value))}", hint
+            )
+        ]
     if kind == "const":
         return [_diag(path, where, f"expected {_show(value)}, got {_show(instance)}", hint)]
     if kind in ("exclusiveMinimum", "minimum", "maximum", "exclusiveMaximum"):
-        word = {"exclusiveMinimum": "greater than", "minimum": "at least", "maximum": "at most",
-                "exclusiveMaximum": "less than"}[kind]
+        word = {
+            "exclusiveMinimum": "greater than",
+            "minimum": "at least",
+            "maximum": "at most",
+            "exclusiveMaximum": "less than",
+        }[kind]
         return [_diag(path, where, f"must be {word} {_num(value)}, got {_show(instance)}", hint)]
     if kind in ("minItems", "maxItems"):
         n = len(instance) if isinstance(instance, list) else 0
@@ -409,9 +563,13 @@ def _schema_diagnostics(error, path: str) -> list[Diagnostic]:
 
 
 def _check_schema(data, path: str) -> list[Diagnostic]:
-    errors = sorted(_validator().iter_errors(data),
-                    key=lambda e: ([(0, p) if isinstance(p, int) else (1, p) for p in e.absolute_path],
-                                   str(e.validator)))
+    errors = sorted(
+        _validator().iter_errors(data),
+        key=lambda e: (
+            [(0, p) if isinstance(p, int) else (1, p) for p in e.absolute_path],
+            str(e.validator),
+        ),
+    )
     out: list[Diagnostic] = []
     seen = set()
     for error in errors:
@@ -423,6 +581,7 @@ def _check_schema(data, path: str) -> list[Diagnostic]:
 
 
 # ---- geometry ---------------------------------------------------------------------------------
+
 
 def _normal(x_axis) -> tuple[float, float, float]:
     """The outward normal of a vertical face whose x axis (left to right from outside) is given:
@@ -461,8 +620,12 @@ def _outline(block: dict) -> list[tuple[str, tuple, tuple, float]]:
     w, _, d = (float(v) for v in block["size"])
     shape = block["shape"]
     if shape == "box":
-        local = {"front": ((w, 0.0, 0.0), (-1.0, 0.0, 0.0), w), "left": ((0.0, 0.0, 0.0), (0.0, 0.0, 1.0), d),
-                 "back": ((0.0, 0.0, d), (1.0, 0.0, 0.0), w), "right": ((w, 0.0, d), (0.0, 0.0, -1.0), d)}
+        local = {
+            "front": ((w, 0.0, 0.0), (-1.0, 0.0, 0.0), w),
+            "left": ((0.0, 0.0, 0.0), (0.0, 0.0, 1.0), d),
+            "back": ((0.0, 0.0, d), (1.0, 0.0, 0.0), w),
+            "right": ((w, 0.0, d), (0.0, 0.0, -1.0), d),
+        }
         return [(name, *local[name]) for name in BOX_RING]
     if shape == "cylinder":
         n = int(block["sides"])
@@ -494,8 +657,10 @@ def _outline(block: dict) -> list[tuple[str, tuple, tuple, float]]:
 def _signed_area(points) -> float:
     """Shoelace area in (x, z); negative for the ring order of a box (front, left, back, right)."""
     n = len(points)
-    return 0.5 * sum(points[i][0] * points[(i + 1) % n][1] - points[(i + 1) % n][0] * points[i][1]
-                     for i in range(n))
+    return 0.5 * sum(
+        points[i][0] * points[(i + 1) % n][1] - points[(i + 1) % n][0] * points[i][1]
+        for i in range(n)
+    )
 
 
 def _side_of(normal) -> str:
@@ -521,6 +686,7 @@ def _names_hint(block: dict) -> str:
 
 # ---- stage 3: meaning, and the model ------------------------------------------------------------
 
+
 class _Reader:
     def __init__(self, data: dict, path: str, fixed: dict[str, bool] | None) -> None:
         from bgr.grammar.registry import KEYWORDS
@@ -544,8 +710,11 @@ class _Reader:
 
     def use_label(self, label: str, where: str) -> None:
         if label in self.keywords:
-            self.fail(where, f"{label!r} is a keyword of the bgr language, so it cannot name a terminal",
-                      f"rename it, e.g. {label}_")
+            self.fail(
+                where,
+                f"{label!r} is a keyword of the bgr language, so it cannot name a terminal",
+                f"rename it, e.g. {label}_",
+            )
         elif label not in self.used:
             self.used.append(label)
 
@@ -555,20 +724,31 @@ class _Reader:
         ids: dict[str, int] = {}
         for i, b in enumerate(blocks):
             if b["id"] in ids:
-                self.fail(f"blocks[{i}].id", f"{b['id']!r} is also the id of blocks[{ids[b['id']]}]",
-                          "block ids are unique")
+                self.fail(
+                    f"blocks[{i}].id",
+                    f"{b['id']!r} is also the id of blocks[{ids[b['id']]}]",
+                    "block ids are unique",
+                )
             else:
                 ids[b["id"]] = i
         for i, b in enumerate(blocks):
             where = f"blocks[{i}]"
             if "sides" in b and b["shape"] != "cylinder":
-                self.fail(f"{where}.sides", f"only a cylinder has sides, and this block is a {b['shape']}")
+                self.fail(
+                    f"{where}.sides", f"only a cylinder has sides, and this block is a {b['shape']}"
+                )
             if "footprint" in b and b["shape"] != "prism":
-                self.fail(f"{where}.footprint", f"only a prism has a footprint, and this block is a {b['shape']}")
+                self.fail(
+                    f"{where}.footprint",
+                    f"only a prism has a footprint, and this block is a {b['shape']}",
+                )
             parent = b.get("parent")
             if parent is not None and parent not in ids:
-                self.fail(f"{where}.parent", f"no block has the id {parent!r}",
-                          suggest(parent, ids) or "parent is the id of another block, or null")
+                self.fail(
+                    f"{where}.parent",
+                    f"no block has the id {parent!r}",
+                    suggest(parent, ids) or "parent is the id of another block, or null",
+                )
             if b["shape"] == "prism" and "footprint" in b:
                 self.check_footprint(b, where)
         # cycles: follow each chain of parents
@@ -580,28 +760,39 @@ class _Reader:
                 parent = blocks[j].get("parent")
                 j = ids.get(parent) if parent is not None else None
             if j is not None and j == i and i not in reported:
-                cycle = chain[chain.index(j):]
+                cycle = chain[chain.index(j) :]
                 reported.update(cycle)
                 names = " -> ".join(repr(blocks[k]["id"]) for k in cycle + [j])
-                self.fail(f"blocks[{i}].parent", f"the parents form a cycle: {names}",
-                          "the scene graph is a tree: one block at its root has parent null")
+                self.fail(
+                    f"blocks[{i}].parent",
+                    f"the parents form a cycle: {names}",
+                    "the scene graph is a tree: one block at its root has parent null",
+                )
         for i, b in enumerate(blocks):
             for k, att in enumerate(b.get("attach", [])):
                 where = f"blocks[{i}].attach[{k}]"
                 if att["face"] not in _face_names(b):
-                    self.fail(f"{where}.face", f"{att['face']!r} is not a face of this {b['shape']}",
-                              suggest(att["face"], _face_names(b)) or _names_hint(b))
+                    self.fail(
+                        f"{where}.face",
+                        f"{att['face']!r} is not a face of this {b['shape']}",
+                        suggest(att["face"], _face_names(b)) or _names_hint(b),
+                    )
                 target = ids.get(att["to"])
                 if target is None:
-                    self.fail(f"{where}.to", f"no block has the id {att['to']!r}",
-                              suggest(att["to"], ids) or "to is the id of another block")
+                    self.fail(
+                        f"{where}.to",
+                        f"no block has the id {att['to']!r}",
+                        suggest(att["to"], ids) or "to is the id of another block",
+                    )
                 elif target == i:
                     self.fail(f"{where}.to", "a block cannot be attached to itself")
                 elif att["to_face"] not in _face_names(blocks[target]):
                     other = blocks[target]
-                    self.fail(f"{where}.to_face",
-                              f"{att['to_face']!r} is not a face of block {att['to']!r} (a {other['shape']})",
-                              suggest(att["to_face"], _face_names(other)) or _names_hint(other))
+                    self.fail(
+                        f"{where}.to_face",
+                        f"{att['to_face']!r} is not a face of block {att['to']!r} (a {other['shape']})",
+                        suggest(att["to_face"], _face_names(other)) or _names_hint(other),
+                    )
         return ids
 
     def check_footprint(self, b: dict, where: str) -> None:
@@ -610,16 +801,23 @@ class _Reader:
         ok = True
         for k, (x, z) in enumerate(pts):
             if not (-TOL <= x <= w + TOL and -TOL <= z <= d + TOL):
-                self.fail(f"{where}.footprint[{k}]", f"[{_num(x)}, {_num(z)}] lies outside the block's "
-                          f"plan [0, {_num(w)}] x [0, {_num(d)}]", "size is [width, height, depth]: the "
-                          "footprint lies within x in [0, width], z in [0, depth]")
+                self.fail(
+                    f"{where}.footprint[{k}]",
+                    f"[{_num(x)}, {_num(z)}] lies outside the block's "
+                    f"plan [0, {_num(w)}] x [0, {_num(d)}]",
+                    "size is [width, height, depth]: the "
+                    "footprint lies within x in [0, width], z in [0, depth]",
+                )
                 ok = False
         n = len(pts)
         for k in range(n):
             p, q = pts[k], pts[(k + 1) % n]
             if math.hypot(q[0] - p[0], q[1] - p[1]) <= TOL:
-                hint = ("do not close the ring: the last point is joined to the first" if k == n - 1
-                        else "each edge of the footprint is a face: it needs a length")
+                hint = (
+                    "do not close the ring: the last point is joined to the first"
+                    if k == n - 1
+                    else "each edge of the footprint is a face: it needs a length"
+                )
                 self.fail(f"{where}.footprint[{(k + 1) % n}]", "repeats the point before it", hint)
                 ok = False
         if ok:
@@ -629,8 +827,11 @@ class _Reader:
             poly = Polygon([(x, z) for x, z in pts])
             if not poly.is_valid or poly.area <= TOL:
                 reason = explain_validity(poly) if not poly.is_valid else "it has no area"
-                self.fail(f"{where}.footprint", f"not a simple polygon: {reason}",
-                          "the points go once round the plan, edges not crossing")
+                self.fail(
+                    f"{where}.footprint",
+                    f"not a simple polygon: {reason}",
+                    "the points go once round the plan, edges not crossing",
+                )
 
     def frames(self, ids: dict[str, int]) -> list[_Frame]:
         """Each block's frame in world coordinates: its transform composed with its parents'."""
@@ -646,8 +847,10 @@ class _Reader:
                 j = ids[parent]
             for k in reversed(chain):
                 t = blocks[k].get("transform", {})
-                local = _Frame(math.radians(t.get("rotate", 0.0)),
-                               [float(v) for v in t.get("translate", (0.0, 0.0, 0.0))])
+                local = _Frame(
+                    math.radians(t.get("rotate", 0.0)),
+                    [float(v) for v in t.get("translate", (0.0, 0.0, 0.0))],
+                )
                 parent = blocks[k].get("parent")
                 done[k] = local.then(done[ids[parent]]) if parent is not None else local
         return [done[i] for i in range(len(blocks))]
@@ -658,13 +861,24 @@ class _Reader:
         floors = b.get("floors") or [{"height": height}]
         total = math.fsum(f["height"] for f in floors)
         if not abs(total - height) <= TOL:
-            self.fail(f"{where}.floors", f"the floor heights sum to {_num(total)} m but the block is "
-                      f"{_num(height)} m tall (size[1])", f"difference {_num(height - total)} m")
+            self.fail(
+                f"{where}.floors",
+                f"the floor heights sum to {_num(total)} m but the block is "
+                f"{_num(height)} m tall (size[1])",
+                f"difference {_num(height - total)} m",
+            )
         return [(f.get("name"), float(f["height"])) for f in floors]
 
 
-def _build_cell(reader: _Reader, sub: dict, width: float, height: float, where: str, size: float,
-                floor_name: str | None = None) -> Cell:
+def _build_cell(
+    reader: _Reader,
+    sub: dict,
+    width: float,
+    height: float,
+    where: str,
+    size: float,
+    floor_name: str | None = None,
+) -> Cell:
     """The Cell of one subface whose rectangle is width x height; ``size`` is its extent along its
     parent's axis.  Sums are checked on the way."""
     label = sub.get("label")
@@ -677,9 +891,13 @@ def _build_cell(reader: _Reader, sub: dict, width: float, height: float, where: 
         total = math.fsum(p["size"] for p in parts)
         if not abs(total - full) <= TOL:
             what = "wide" if axis == "x" else "tall"
-            reader.fail(where, f"the parts (split {axis}) sum to {_num(total)} m but the subface is "
-                        f"{_num(full)} m {what}",
-                        f"difference {_num(full - total)} m; sizes: " + " + ".join(_num(p["size"]) for p in parts))
+            reader.fail(
+                where,
+                f"the parts (split {axis}) sum to {_num(total)} m but the subface is "
+                f"{_num(full)} m {what}",
+                f"difference {_num(full - total)} m; sizes: "
+                + " + ".join(_num(p["size"]) for p in parts),
+            )
         cells = []
         for k, p in enumerate(parts):
             s = float(p["size"])
@@ -706,22 +924,32 @@ def _faces_of(reader: _Reader, b: dict, i: int, frame: _Frame) -> list[tuple[str
     given = b.get("faces", {})
     for name in given:
         if name not in names:
-            reader.fail(_join(f"{where}.faces", name), f"not a face of this {b['shape']}",
-                        suggest(name, names) or _names_hint(b))
+            reader.fail(
+                _join(f"{where}.faces", name),
+                f"not a face of this {b['shape']}",
+                suggest(name, names) or _names_hint(b),
+            )
     plain = b.get("plain", PLAIN)
     reader.use_label(plain, f"{where}.plain" if "plain" in b else where)
     out = []
     for name, origin, x_axis, width in _outline(b):
         fwhere = _join(f"{where}.faces", name)
         if not width > TOL:
-            reader.fail(fwhere, f"the face is {_num(width)} m wide: too narrow to check its subfaces",
-                        "faces are at least 1e-6 m wide: check the block's size")
+            reader.fail(
+                fwhere,
+                f"the face is {_num(width)} m wide: too narrow to check its subfaces",
+                "faces are at least 1e-6 m wide: check the block's size",
+            )
             continue
         subs = given.get(name)
         if subs is not None and len(subs) != len(floors):
-            reader.fail(fwhere, f"{len(subs)} subface{'s' * (len(subs) != 1)} for {len(floors)} "
-                        f"floor{'s' * (len(floors) != 1)}", "one subface per floor, bottom to top: "
-                        + ", ".join(n or f"floor {k}" for k, (n, _) in enumerate(floors)))
+            reader.fail(
+                fwhere,
+                f"{len(subs)} subface{'s' * (len(subs) != 1)} for {len(floors)} "
+                f"floor{'s' * (len(floors) != 1)}",
+                "one subface per floor, bottom to top: "
+                + ", ".join(n or f"floor {k}" for k, (n, _) in enumerate(floors)),
+            )
             subs = None
         cells = []
         for k, (floor_name, fh) in enumerate(floors):
@@ -731,22 +959,34 @@ def _faces_of(reader: _Reader, b: dict, i: int, frame: _Frame) -> list[tuple[str
             sub = subs[k]
             swhere = f"{fwhere}[{k}]"
             if "size" in sub and not abs(sub["size"] - fh) <= TOL:
-                reader.fail(f"{swhere}.size", f"{_num(sub['size'])} m, but floor {k}"
-                            f"{' (' + repr(floor_name) + ')' if floor_name else ''} is {_num(fh)} m tall",
-                            "a floor's subface may leave size out: it is the floor's height")
+                reader.fail(
+                    f"{swhere}.size",
+                    f"{_num(sub['size'])} m, but floor {k}"
+                    f"{' (' + repr(floor_name) + ')' if floor_name else ''} is {_num(fh)} m tall",
+                    "a floor's subface may leave size out: it is the floor's height",
+                )
             cells.append(_build_cell(reader, sub, width, fh, swhere, fh, floor_name))
         root = Cell(width, axis="y", parts=cells)
         _set_fixed(root, None)
         world_x = frame.direction(x_axis)
         normal = _normal(world_x)
-        face = Face(width, height, root, side=_side_of(_normal(x_axis)), name=_camel(b["id"], name),
-                    origin=frame.point(origin), x_axis=world_x, normal=normal)
+        face = Face(
+            width,
+            height,
+            root,
+            side=_side_of(_normal(x_axis)),
+            name=_camel(b["id"], name),
+            origin=frame.point(origin),
+            x_axis=world_x,
+            normal=normal,
+        )
         out.append((name, face))
     return out
 
 
-def _attachments(reader: _Reader, blocks: list[dict], faces: list[dict[str, Face]],
-                 ids: dict[str, int]) -> tuple[set[int], set[int]]:
+def _attachments(
+    reader: _Reader, blocks: list[dict], faces: list[dict[str, Face]], ids: dict[str, int]
+) -> tuple[set[int], set[int]]:
     """(the faces an attachment covers completely, the faces whose left end it covers), as ids
     of Face objects; checks that attached faces are coplanar, face each other and overlap."""
     hidden: set[int] = set()
@@ -756,22 +996,34 @@ def _attachments(reader: _Reader, blocks: list[dict], faces: list[dict[str, Face
             where = f"blocks[{i}].attach[{k}]"
             a = faces[i][att["face"]]
             other = faces[ids[att["to"]]][att["to_face"]]
-            pair = f"face {att['face']!r} of {b['id']!r} and face {att['to_face']!r} of {att['to']!r}"
+            pair = (
+                f"face {att['face']!r} of {b['id']!r} and face {att['to_face']!r} of {att['to']!r}"
+            )
             facing = sum(a.normal[j] * other.normal[j] for j in range(3))
             gap = sum((other.origin[j] - a.origin[j]) * a.normal[j] for j in range(3))
             if not facing <= -1 + 1e-9:
-                reader.fail(where, f"{pair} do not face each other", "attached faces are coplanar with "
-                            "opposite normals: check the blocks' transforms")
+                reader.fail(
+                    where,
+                    f"{pair} do not face each other",
+                    "attached faces are coplanar with "
+                    "opposite normals: check the blocks' transforms",
+                )
                 continue
             if not abs(gap) <= GEOM_TOL:
-                reader.fail(where, f"{pair} are {_num(abs(gap))} m apart",
-                            "attached faces are coplanar: check the blocks' sizes and transforms")
+                reader.fail(
+                    where,
+                    f"{pair} are {_num(abs(gap))} m apart",
+                    "attached faces are coplanar: check the blocks' sizes and transforms",
+                )
                 continue
             for face, cover in ((a, other), (other, a)):
                 covered, touch, start = _covers(cover, face)
                 if not touch:
-                    reader.fail(where, f"{pair} are in one plane but do not overlap",
-                                "check the blocks' sizes and transforms")
+                    reader.fail(
+                        where,
+                        f"{pair} are in one plane but do not overlap",
+                        "check the blocks' sizes and transforms",
+                    )
                     break
                 if covered:
                     hidden.add(id(face))
@@ -788,14 +1040,19 @@ def _covers(cover: Face, face: Face) -> tuple[bool, bool, bool]:
     lo, hi = min(u0, u1), max(u0, u1)
     y_lo, y_hi = cover.origin[1], cover.origin[1] + cover.height
     f_lo, f_hi = face.origin[1], face.origin[1] + face.height
-    touch = min(hi, face.width) - max(lo, 0.0) > GEOM_TOL and min(y_hi, f_hi) - max(y_lo, f_lo) > GEOM_TOL
+    touch = (
+        min(hi, face.width) - max(lo, 0.0) > GEOM_TOL
+        and min(y_hi, f_hi) - max(y_lo, f_lo) > GEOM_TOL
+    )
     across = y_lo <= f_lo + GEOM_TOL and y_hi >= f_hi - GEOM_TOL
     covered = touch and across and lo <= GEOM_TOL and hi >= face.width - GEOM_TOL
     start = touch and lo <= GEOM_TOL and y_lo <= f_lo + GEOM_TOL
     return covered, touch, start
 
 
-def model_from_captured(data, path: str = "<captured>", fixed: dict[str, bool] | None = None) -> Model:
+def model_from_captured(
+    data, path: str = "<captured>", fixed: dict[str, bool] | None = None
+) -> Model:
     """The Model of a parsed captured-model JSON.  ``fixed`` overrides the file's ``labels``.
 
     Every problem raises :class:`BgrError`, its diagnostics naming the element by JSON path."""
@@ -830,8 +1087,10 @@ def model_from_captured(data, path: str = "<captured>", fixed: dict[str, bool] |
         raise _error(path, "blocks", "every face is hidden by an attachment: nothing to infer from")
     # link_faces joins a face to the first face that starts where it ends: one whose start an
     # attached block hides goes last, so that a wall running on past the attachment wins
-    link_faces([f for f in all_faces if id(f) not in start_covered]
-               + [f for f in all_faces if id(f) in start_covered])
+    link_faces(
+        [f for f in all_faces if id(f) not in start_covered]
+        + [f for f in all_faces if id(f) in start_covered]
+    )
     model_blocks = []
     for b, faces, ring in zip(blocks, kept, built):
         w, h, d = (float(v) for v in b["size"])

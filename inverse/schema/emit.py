@@ -32,8 +32,12 @@ from .model import Cell, Face, Model
 
 SIDES = ("front", "right", "back", "left")
 _IDENT = re.compile(r"[A-Za-z_][A-Za-z0-9_]*")
-_RESERVED = set(OPERATIONS) | set(KEYWORDS) | set(BUILTIN_NAMES) | {"NIL", "true", "false", "and", "or", "not",
-                                                                    "case", "else"}
+_RESERVED = (
+    set(OPERATIONS)
+    | set(KEYWORDS)
+    | set(BUILTIN_NAMES)
+    | {"NIL", "true", "false", "and", "or", "not", "case", "else"}
+)
 
 
 @dataclass(frozen=True)
@@ -78,7 +82,11 @@ class Emitter:
                 self.leaf[label] = label
                 self.taken.add(label)
                 if colors.get(label, _GREY) != _GREY:
-                    self.colored.append(n.Rule(label, [], n.Sequence([n.Operation("color", [n.String(colors[label])])])))
+                    self.colored.append(
+                        n.Rule(
+                            label, [], n.Sequence([n.Operation("color", [n.String(colors[label])])])
+                        )
+                    )
                 else:
                     self.terminals.append(label)
         for label in self.labels:
@@ -125,7 +133,9 @@ class Emitter:
         parts = cell.parts
         keys = [f"{p.key()}@{round(p.size, 4)}{'!' if p.fixed else ''}" for p in parts]
         syms = fs.symbols(keys)
-        items = _model_rows(syms) if floors and cell.axis == "y" else _extend(fs.rewrite(syms), syms)
+        items = (
+            _model_rows(syms) if floors and cell.axis == "y" else _extend(fs.rewrite(syms), syms)
+        )
         if any(isinstance(it, Run) for it in items):
             items = _expressible(items)
         else:  # the pair rule's own groups: faces.unroll also settles ties between equal groups
@@ -141,7 +151,9 @@ class Emitter:
             if isinstance(it, fs.Sym):
                 out.append(self.entry(parts[it.index]))
             elif isinstance(it, fs.Star):
-                out.append(n.Group([self.entry(parts[it.first_index]), self.entry(parts[it.second_index])]))
+                out.append(
+                    n.Group([self.entry(parts[it.first_index]), self.entry(parts[it.second_index])])
+                )
             else:
                 out.append(n.Group([self.entry(parts[it.index])]))
         return out
@@ -196,8 +208,12 @@ class Emitter:
         cases = []
         for (a, name), (b, _) in itertools.pairwise(widths):
             mid = (a.width + b.width) / 2
-            cases.append(n.Case(n.Binary("<", n.Name("scope.sx"), n.Number(_clean(mid))),
-                                n.Sequence([n.Successor(name)])))
+            cases.append(
+                n.Case(
+                    n.Binary("<", n.Name("scope.sx"), n.Number(_clean(mid))),
+                    n.Sequence([n.Successor(name)]),
+                )
+            )
         cases.append(n.Case(None, n.Sequence([n.Successor(widths[-1][1])])))
         rule_name = self.by_key[key] = self.fresh("ByWidth")
         self.rules.append(n.Rule(rule_name, [], _body(_merge(cases))))
@@ -212,33 +228,69 @@ class Emitter:
         # comp entries in the order the source's faces came out, so its terminal order comes back
         seen = [_side(f) for f in sorted(self.model.faces(), key=lambda f: f.order)]
         order = list(dict.fromkeys(seen + list(SIDES)))
-        entries = [n.Entry("abs", n.Name(s), n.Sequence([n.Successor(choosers[s].name)])) for s in order]
-        entries.append(n.Entry("abs", n.Name("top"), n.Sequence([n.Successor(self.leaf[roof])] if roof else [n.Nil()])))
+        entries = [
+            n.Entry("abs", n.Name(s), n.Sequence([n.Successor(choosers[s].name)])) for s in order
+        ]
+        entries.append(
+            n.Entry(
+                "abs",
+                n.Name("top"),
+                n.Sequence([n.Successor(self.leaf[roof])] if roof else [n.Nil()]),
+            )
+        )
         entries.append(n.Entry("abs", n.Name("bottom"), n.Sequence([n.Nil()])))
-        lot = n.Rule("Lot", [], n.Sequence([
-            n.Operation("extrude", [n.Name("height")]),
-            n.Operation("comp", [n.Name("f")], n.Block(entries))]))
+        lot = n.Rule(
+            "Lot",
+            [],
+            n.Sequence(
+                [
+                    n.Operation("extrude", [n.Name("height")]),
+                    n.Operation("comp", [n.Name("f")], n.Block(entries)),
+                ]
+            ),
+        )
         head = [n.Version(1), n.Attr("height", n.Number(_clean(basis.height)))]
         if self.terminals:
             head.append(n.TerminalDecl(list(self.terminals)))
         faces = sum(len(b.faces) for b in self.model.blocks)
         leaves = sum(f.root.count() for f in self.model.faces())
-        header = [f"# Inferred by bgr infer --kind schema from {self.model.source or 'a model'}:",
-                  f"# {faces} faces, {leaves} subfaces; {len(self.rules)} schema rules. Derive it on a lot:",
-                  "#   bgr derive THIS.bgr --lot W,D|LOTS.geojson -o out.glb   (--set height=H)"]
+        header = [
+            f"# Inferred by bgr infer --kind schema from {self.model.source or 'a model'}:",
+            f"# {faces} faces, {leaves} subfaces; {len(self.rules)} schema rules. Derive it on a lot:",
+            "#   bgr derive THIS.bgr --lot W,D|LOTS.geojson -o out.glb   (--set height=H)",
+        ]
         if self.model.dropped:
-            header.insert(2, f"# ({self.model.dropped} small faces on no mass, such as the sides of "
-                             "bays and dormers, are left out.)")
+            header.insert(
+                2,
+                f"# ({self.model.dropped} small faces on no mass, such as the sides of "
+                "bays and dormers, are left out.)",
+            )
         return _laid_out(header, [head, [lot], list(choosers.values()), self.rules, self.colored])
 
 
 # ---- symbol strings ----------------------------------------------------------------------------
 
 _GREY = "#cccccc"  # the interpreter's default colour: nothing to write
-_COMMON = {"window": "#3b4a5a", "glass": "#3b4a5a", "door": "#5a3a28", "entrance": "#5a3a28", "brick": "#9c4a35",
-           "wall": "#d8c8a8", "plinth": "#8c8a84", "base": "#8c8a84", "trim": "#e4ddd0", "cornice": "#e4ddd0",
-           "sill": "#e4ddd0", "pier": "#c9b99b", "pilaster": "#c9b99b", "roof": "#6b6b6b", "shop": "#4a6a7a",
-           "sign": "#2f4f4f", "fascia": "#2f4f4f", "step": "#a9a9a4"}
+_COMMON = {
+    "window": "#3b4a5a",
+    "glass": "#3b4a5a",
+    "door": "#5a3a28",
+    "entrance": "#5a3a28",
+    "brick": "#9c4a35",
+    "wall": "#d8c8a8",
+    "plinth": "#8c8a84",
+    "base": "#8c8a84",
+    "trim": "#e4ddd0",
+    "cornice": "#e4ddd0",
+    "sill": "#e4ddd0",
+    "pier": "#c9b99b",
+    "pilaster": "#c9b99b",
+    "roof": "#6b6b6b",
+    "shop": "#4a6a7a",
+    "sign": "#2f4f4f",
+    "fascia": "#2f4f4f",
+    "step": "#a9a9a4",
+}
 
 
 def _default_color(label: str) -> str:
@@ -269,7 +321,11 @@ def _extend(items, syms):
         it = items[i]
         if isinstance(it, fs.Sym):
             j = i
-            while j + 1 < len(items) and isinstance(items[j + 1], fs.Sym) and syms[items[j + 1].index] == syms[it.index]:
+            while (
+                j + 1 < len(items)
+                and isinstance(items[j + 1], fs.Sym)
+                and syms[items[j + 1].index] == syms[it.index]
+            ):
                 j += 1
             if j - i + 1 >= 3:
                 out.append(Run(it.index, j - i + 1))
@@ -295,8 +351,11 @@ def _model_rows(syms):
     start, length = best
     if length < 2:
         return _extend(fs.rewrite(syms), syms)
-    return ([fs.Sym(k) for k in range(start)] + [Run(start, length)]
-            + [fs.Sym(k) for k in range(start + length, len(syms))])
+    return (
+        [fs.Sym(k) for k in range(start)]
+        + [Run(start, length)]
+        + [fs.Sym(k) for k in range(start + length, len(syms))]
+    )
 
 
 def _expressible(items):
@@ -324,6 +383,7 @@ def _expressible(items):
 
 def _reproduces(entries, parts: list[Cell], length: float) -> bool:
     """Does the split solver lay these entries out at the source length exactly as the source?"""
+
     def item(e):
         if isinstance(e, n.Group):
             return solver.Repeat(tuple(item(x) for x in e.entries))
@@ -337,12 +397,15 @@ def _reproduces(entries, parts: list[Cell], length: float) -> bool:
 
 # ---- floor-schema choice -------------------------------------------------------------------
 
+
 def _corner_test(name: str, kind: str):
     if kind == "outer":
         return n.Binary(">", n.Name(name), n.Number(1))
     if kind == "inner":
         return n.Binary("<", n.Name(name), n.Number(-1))
-    return n.Binary("and", n.Binary(">=", n.Name(name), n.Number(-1)), n.Binary("<=", n.Name(name), n.Number(1)))
+    return n.Binary(
+        "and", n.Binary(">=", n.Name(name), n.Number(-1)), n.Binary("<=", n.Name(name), n.Number(1))
+    )
 
 
 def _and(a, b):
@@ -352,6 +415,7 @@ def _and(a, b):
 def _ranked(pool, left: str, right: str):
     """The faces of ``pool`` that best fit a face with these corners: most matching corners
     (a free edge counts as an outer corner); ties are settled by width later."""
+
     def score(face: Face) -> int:
         fl = "outer" if face.left == "free" else face.left
         fr = "outer" if face.right == "free" else face.right

@@ -43,6 +43,7 @@ Item = Sym | Star
 
 # ---- the symbolic rule (steps 2-5) -------------------------------------------------------------
 
+
 def symbols(keys: Sequence[Hashable]) -> list[str]:
     """Step 2: a symbol per column, equal iff the columns' keys are equal.
 
@@ -72,7 +73,9 @@ def rewrite(symbols: Sequence[str]) -> list[Item]:
     stars of derivation 2 (``AABAABAA`` -> ``A(AB)*A(AB)*AA``) do.
     """
     n = len(symbols)
-    occurs = Counter((symbols[i], symbols[i + 1]) for i in range(n - 1) if symbols[i] != symbols[i + 1])
+    occurs = Counter(
+        (symbols[i], symbols[i + 1]) for i in range(n - 1) if symbols[i] != symbols[i + 1]
+    )
     items: list[Item] = []
     i = 0
     while i < n:
@@ -82,7 +85,10 @@ def rewrite(symbols: Sequence[str]) -> list[Item]:
             i += 1
             continue
         last = items[-1] if items else None
-        if isinstance(last, Star) and (symbols[last.first_index], symbols[last.second_index]) == pair:
+        if (
+            isinstance(last, Star)
+            and (symbols[last.first_index], symbols[last.second_index]) == pair
+        ):
             items[-1] = Star(last.first_index, last.second_index, last.count + 1)  # step 4
         else:
             items.append(Star(i, i + 1, 1))
@@ -92,8 +98,12 @@ def rewrite(symbols: Sequence[str]) -> list[Item]:
 
 def to_text(items: Sequence[Item], symbols: Sequence[str]) -> str:
     """The rule as the paper writes it, e.g. ``A(BC)*BA``."""
-    return "".join(symbols[it.index] if isinstance(it, Sym)
-                   else f"({symbols[it.first_index]}{symbols[it.second_index]})*" for it in items)
+    return "".join(
+        symbols[it.index]
+        if isinstance(it, Sym)
+        else f"({symbols[it.first_index]}{symbols[it.second_index]})*"
+        for it in items
+    )
 
 
 def stars(items: Sequence[Item]) -> list[Star]:
@@ -116,13 +126,17 @@ def expand(items: Sequence[Item], counts: Sequence[int] | None = None) -> list[i
 
 # ---- applying the rule to a novel face ---------------------------------------------------------
 
+
 def counts_expressible(counts: Sequence[int]) -> bool:
     """Whether the application rule can produce these counts at all: all are k or k + 1."""
     return not counts or max(counts) - min(counts) <= 1
 
 
-def unroll(items: Sequence[Item], counts: Sequence[int] | None = None,
-           widths: Sequence[float] | None = None) -> list[Item]:
+def unroll(
+    items: Sequence[Item],
+    counts: Sequence[int] | None = None,
+    widths: Sequence[float] | None = None,
+) -> list[Item]:
     """Pull repetitions out of stars as plain columns until the star counts are all k or k + 1.
 
     ``counts`` are the repetitions each star stands for (default: the original ones).  The
@@ -146,7 +160,9 @@ def unroll(items: Sequence[Item], counts: Sequence[int] | None = None,
         width = sum(n * p for n, p in zip(keep, pair))
         for extra in itertools.product((0, 1), repeat=len(keep)):
             other = [k + e for e in extra]
-            if other != keep and abs(sum(n * p for n, p in zip(other, pair)) - width) <= EPS * max(1.0, width):
+            if other != keep and abs(sum(n * p for n, p in zip(other, pair)) - width) <= EPS * max(
+                1.0, width
+            ):
                 keep = [k] * len(counts)
                 break
     return _pull(items, counts, keep)
@@ -166,8 +182,13 @@ def _pull(items: Sequence[Item], counts: Sequence[int], keep: Sequence[int]) -> 
     return out
 
 
-def retarget(items: Sequence[Item], widths: Sequence[float], fixed: Sequence[bool],
-             length: float, minimum: int = 0) -> tuple[tuple[int, ...], float]:
+def retarget(
+    items: Sequence[Item],
+    widths: Sequence[float],
+    fixed: Sequence[bool],
+    length: float,
+    minimum: int = 0,
+) -> tuple[tuple[int, ...], float]:
     """The paper's application rule: repetitions per star (in order) and the variable scale.
 
     ``widths``/``fixed`` are per column position; a star's repetition has the widths of its
@@ -187,9 +208,12 @@ def retarget(items: Sequence[Item], widths: Sequence[float], fixed: Sequence[boo
     combination that fills most without overflowing wins (scale 1); when fixed columns alone
     leave no room for variable ones, the counts are k each and the scale is 0.
     """
+
     def nominal(columns: Sequence[int]) -> tuple[float, float]:
-        return (sum(widths[c] for c in columns if fixed[c]),
-                sum(widths[c] for c in columns if not fixed[c]))
+        return (
+            sum(widths[c] for c in columns if fixed[c]),
+            sum(widths[c] for c in columns if not fixed[c]),
+        )
 
     out_fixed, out_var = nominal([it.index for it in items if isinstance(it, Sym)])
     groups = [nominal((s.first_index, s.second_index)) for s in stars(items)]
@@ -212,8 +236,11 @@ def retarget(items: Sequence[Item], widths: Sequence[float], fixed: Sequence[boo
             if fixed_width > length + EPS:
                 continue  # overflows
             scale, distance = 1.0, length - fixed_width
-        if best is None or distance < best[2] - TIE or (
-                distance <= best[2] + TIE and sum(counts) > sum(best[0])):
+        if (
+            best is None
+            or distance < best[2] - TIE
+            or (distance <= best[2] + TIE and sum(counts) > sum(best[0]))
+        ):
             best = (counts, scale, distance)
     if best is None:
         return (k,) * len(groups), 0.0 if stretchy else 1.0

@@ -47,7 +47,9 @@ class Cell:
         rewrite string (the keys of its parts, with their sizes — see ``docs/inverse-schema.md``)."""
         if self.is_leaf:
             return self.label or "_"
-        inner = ",".join(f"{p.key()}@{round(p.size, KEY_DIGITS)}{'!' if p.fixed else ''}" for p in self.parts)
+        inner = ",".join(
+            f"{p.key()}@{round(p.size, KEY_DIGITS)}{'!' if p.fixed else ''}" for p in self.parts
+        )
         return f"{self.axis}[{inner}]"
 
     def leaves(self) -> list[Cell]:

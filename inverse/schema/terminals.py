@@ -59,17 +59,28 @@ def _error(path: str, message: str, hint: str | None = None) -> BgrError:
 
 
 def _vector(value, n: int, where: str, path: str) -> tuple:
-    if not isinstance(value, list) or len(value) != n or not all(
-            isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v) for v in value):
-        raise _error(path, f"{where} must be a list of {n} finite numbers, got {json.dumps(value)[:60]}")
+    if (
+        not isinstance(value, list)
+        or len(value) != n
+        or not all(
+            isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v)
+            for v in value
+        )
+    ):
+        raise _error(
+            path, f"{where} must be a list of {n} finite numbers, got {json.dumps(value)[:60]}"
+        )
     return tuple(float(v) for v in value)
 
 
 def read_terminals(data: dict, path: str = "<terminals>") -> list[_Terminal]:
     """The terminals of a parsed terminal-list JSON, checked: each error names the element."""
     if not isinstance(data, dict) or not isinstance(data.get("terminals"), list):
-        raise _error(path, "not a bgr terminal list: expected an object with a 'terminals' list",
-                     "write one with: bgr derive FILE.bgr -o terminals.json")
+        raise _error(
+            path,
+            "not a bgr terminal list: expected an object with a 'terminals' list",
+            "write one with: bgr derive FILE.bgr -o terminals.json",
+        )
     out = []
     for i, t in enumerate(data["terminals"]):
         where = f"terminals[{i}]"
@@ -122,6 +133,7 @@ def _tree(terminals: list[_Terminal]) -> _Node:
 
 # ---- faces ------------------------------------------------------------------------------------
 
+
 def _dot(a, b) -> float:
     return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 
@@ -143,7 +155,10 @@ def _coplanar(terminals: list[_Terminal]) -> bool:
     first = terminals[0]
     normal = first.axes[2]
     plane = _dot(first.origin, normal)
-    return all(_same_axes(t.axes, first.axes) and abs(_dot(t.origin, normal) - plane) < DEPTH for t in terminals)
+    return all(
+        _same_axes(t.axes, first.axes) and abs(_dot(t.origin, normal) - plane) < DEPTH
+        for t in terminals
+    )
 
 
 LINK = 0.6  # metres: face corners this close are one corner
@@ -160,8 +175,10 @@ def _main_plane(terminals: list[_Terminal]) -> set[int] | None:
     groups: list[tuple[_Terminal, list[_Terminal]]] = []
     for t in terminals:
         for first, members in groups:
-            if _same_axes(t.axes, first.axes) and abs(
-                    _dot(t.origin, first.axes[2]) - _dot(first.origin, first.axes[2])) < DEPTH:
+            if (
+                _same_axes(t.axes, first.axes)
+                and abs(_dot(t.origin, first.axes[2]) - _dot(first.origin, first.axes[2])) < DEPTH
+            ):
                 members.append(t)
                 break
         else:
@@ -181,7 +198,11 @@ def _face_nodes(node: _Node, out: list) -> None:
     with no rule of its own (``comp(f) { front: split(x) { ... } }``), the children in one plane
     are gathered into one face."""
     if node.terminals and node.path:
-        kept = {t.index for t in node.terminals} if _coplanar(node.terminals) else _main_plane(node.terminals)
+        kept = (
+            {t.index for t in node.terminals}
+            if _coplanar(node.terminals)
+            else _main_plane(node.terminals)
+        )
         if kept:
             out.append((node, kept))
             return
@@ -194,7 +215,9 @@ def _face_nodes(node: _Node, out: list) -> None:
         if not terms or not any(_flat(t) for t in terms):  # a solid (a roof, a box), no face
             continue
         first = terms[0]
-        key = tuple(round(v, 5) for v in first.axes[2]) + (round(_dot(first.origin, first.axes[2]), 5),)
+        key = tuple(round(v, 5) for v in first.axes[2]) + (
+            round(_dot(first.origin, first.axes[2]), 5),
+        )
         if key not in planes:
             planes[key] = _Node(node.path, gathered=True)
             out.append(planes[key])  # keeps derivation order among faces
@@ -202,7 +225,11 @@ def _face_nodes(node: _Node, out: list) -> None:
         planes[key].terminals += terms
     for i, entry in enumerate(out):  # a plane of one child rule is that rule's own face
         if isinstance(entry, _Node):
-            only = entry.items[0] if len(entry.items) == 1 and isinstance(entry.items[0], _Node) else entry
+            only = (
+                entry.items[0]
+                if len(entry.items) == 1 and isinstance(entry.items[0], _Node)
+                else entry
+            )
             out[i] = (only, {t.index for t in entry.terminals})
 
 
@@ -213,13 +240,22 @@ class _Frame:
     y: tuple[float, float, float]
 
     def rect(self, t: _Terminal) -> tuple[float, float, float, float]:
-        d = (t.origin[0] - self.origin[0], t.origin[1] - self.origin[1], t.origin[2] - self.origin[2])
+        d = (
+            t.origin[0] - self.origin[0],
+            t.origin[1] - self.origin[1],
+            t.origin[2] - self.origin[2],
+        )
         u, v = _dot(d, self.x), _dot(d, self.y)
         return (u, v, u + t.size[0], v + t.size[1])
 
 
 def _union(rects) -> tuple[float, float, float, float]:
-    return (min(r[0] for r in rects), min(r[1] for r in rects), max(r[2] for r in rects), max(r[3] for r in rects))
+    return (
+        min(r[0] for r in rects),
+        min(r[1] for r in rects),
+        max(r[2] for r in rects),
+        max(r[3] for r in rects),
+    )
 
 
 class _Builder:
@@ -232,12 +268,22 @@ class _Builder:
         """A node's items that hold kept terminals, in derivation order."""
         if self.kept is None:
             return node.items
-        return [item for item in node.items
-                if (any(t.index in self.kept for t in item.terminals) if isinstance(item, _Node)
-                    else item.index in self.kept)]
+        return [
+            item
+            for item in node.items
+            if (
+                any(t.index in self.kept for t in item.terminals)
+                if isinstance(item, _Node)
+                else item.index in self.kept
+            )
+        ]
 
     def terms(self, node: _Node) -> list[_Terminal]:
-        return node.terminals if self.kept is None else [t for t in node.terminals if t.index in self.kept]
+        return (
+            node.terminals
+            if self.kept is None
+            else [t for t in node.terminals if t.index in self.kept]
+        )
 
     def is_fixed(self, label: str) -> bool:
         return self.fixed.get(label, default_fixed(label))
@@ -266,7 +312,8 @@ class _Builder:
             return inner
         children = self.items_of(item)
         cell = self.partition(children, rect, size) or self.guillotine(
-            [(self.frame.rect(t), t) for t in self.terms(item)], rect, size)
+            [(self.frame.rect(t), t) for t in self.terms(item)], rect, size
+        )
         cell.label = item.name
         return cell
 
@@ -279,14 +326,20 @@ class _Builder:
         short_y = h < slot[3] - slot[1] - TOL
         cell = self.leaf(t, size if not short_x else h if short_y else w)
         if short_y:
-            parts = ([Cell(r[1] - slot[1])] if r[1] > slot[1] + TOL else []) + [Cell(h, t.label, fixed=cell.fixed)] + (
-                [Cell(slot[3] - r[3])] if slot[3] > r[3] + TOL else [])
+            parts = (
+                ([Cell(r[1] - slot[1])] if r[1] > slot[1] + TOL else [])
+                + [Cell(h, t.label, fixed=cell.fixed)]
+                + ([Cell(slot[3] - r[3])] if slot[3] > r[3] + TOL else [])
+            )
             cell = _split("y", parts, w if short_x else size)
         if short_x:
             inner = cell if short_y else Cell(w, t.label, fixed=cell.fixed)
             inner.size = w
-            parts = ([Cell(r[0] - slot[0])] if r[0] > slot[0] + TOL else []) + [inner] + (
-                [Cell(slot[2] - r[2])] if slot[2] > r[2] + TOL else [])
+            parts = (
+                ([Cell(r[0] - slot[0])] if r[0] > slot[0] + TOL else [])
+                + [inner]
+                + ([Cell(slot[2] - r[2])] if slot[2] > r[2] + TOL else [])
+            )
             cell = _split("x", parts, size)
         return cell
 
@@ -371,6 +424,7 @@ def _set_fixed(cell: Cell, axis: str | None) -> None:
 
 # ---- lots, sides, corners and blocks --------------------------------------------------------
 
+
 def _lot_frames(data: dict, path: str) -> dict[str, tuple]:
     """The axes of each lot (``lots`` of the terminal list, written since this reader exists):
     a face's side is read in its lot's frame, as comp(f) reads it, not in the world's."""
@@ -384,7 +438,9 @@ def _lot_frames(data: dict, path: str) -> dict[str, tuple]:
         axes = lot.get("axes")
         if not isinstance(axes, list) or len(axes) != 3:
             raise _error(path, f"lots[{i}].axes must be three 3-vectors")
-        frames[lot["path"]] = tuple(_vector(a, 3, f"lots[{i}].axes[{j}]", path) for j, a in enumerate(axes))
+        frames[lot["path"]] = tuple(
+            _vector(a, 3, f"lots[{i}].axes[{j}]", path) for j, a in enumerate(axes)
+        )
     return frames
 
 
@@ -397,8 +453,6 @@ def side_of(normal, axes=None) -> str:
     if abs(x) >= abs(z):
         return "right" if x > 0 else "left"
     return "back" if z > 0 else "front"
-
-
 
 
 def _corner(x_left, x_right) -> str:
@@ -429,7 +483,9 @@ def link_faces(faces: list[Face]) -> list[list[Face]]:
     for f in faces:
         end = tuple(f.origin[i] + f.width * f.x_axis[i] for i in range(3))
         bx, bz = bucket(end)
-        near = [g for dx in (-1, 0, 1) for dz in (-1, 0, 1) for g in starts.get((bx + dx, bz + dz), [])]
+        near = [
+            g for dx in (-1, 0, 1) for dz in (-1, 0, 1) for g in starts.get((bx + dx, bz + dz), [])
+        ]
         best, rank = None, (LINK, 0.0)
         for g in near:
             d = math.dist((end[0], end[1], end[2]), g.origin)
@@ -457,7 +513,9 @@ def link_faces(faces: list[Face]) -> list[list[Face]]:
     return blocks
 
 
-def model_from_terminals(data: dict, path: str = "<terminals>", fixed: dict[str, bool] | None = None) -> Model:
+def model_from_terminals(
+    data: dict, path: str = "<terminals>", fixed: dict[str, bool] | None = None
+) -> Model:
     """The Model of a terminal list: its vertical faces, subdivided, in derivation order, with
     their corners; horizontal faces' labels are kept for the roof."""
     terminals = read_terminals(data, path)
@@ -477,7 +535,9 @@ def model_from_terminals(data: dict, path: str = "<terminals>", fixed: dict[str,
         probe = _Frame(first.origin, first.axes[0], first.axes[1])
         rects = [probe.rect(t) for t in terms]
         u0, v0, u1, v1 = _union(rects)
-        origin = tuple(first.origin[i] + u0 * first.axes[0][i] + v0 * first.axes[1][i] for i in range(3))
+        origin = tuple(
+            first.origin[i] + u0 * first.axes[0][i] + v0 * first.axes[1][i] for i in range(3)
+        )
         frame = _Frame(origin, first.axes[0], first.axes[1])
         builder = _Builder(frame, fixed, kept)
         rect = (0.0, 0.0, u1 - u0, v1 - v0)
@@ -486,30 +546,57 @@ def model_from_terminals(data: dict, path: str = "<terminals>", fixed: dict[str,
         lot = first.path.split("/", 1)[0]
         side = side_of(first.axes[2], frames.get(lot))
         name = side.capitalize() + "Face" if group.gathered else group.name
-        faces.append(Face(rect[2], rect[3], root, name=name, origin=origin, x_axis=first.axes[0],
-                          normal=first.axes[2], order=len(faces), lot=lot, side=side))
+        faces.append(
+            Face(
+                rect[2],
+                rect[3],
+                root,
+                name=name,
+                origin=origin,
+                x_axis=first.axes[0],
+                normal=first.axes[2],
+                order=len(faces),
+                lot=lot,
+                side=side,
+            )
+        )
     if not faces:
-        raise _error(path, "no vertical faces in the terminal list",
-                     "face schemas are inferred from façades: flat terminals on the sides of a mass")
+        raise _error(
+            path,
+            "no vertical faces in the terminal list",
+            "face schemas are inferred from façades: flat terminals on the sides of a mass",
+        )
     by_lot: dict[str, list[Face]] = {}
     for f in faces:
         by_lot.setdefault(f.lot, []).append(f)
     rings = [ring for lot_faces in by_lot.values() for ring in link_faces(lot_faces)]
+
     # a mass is a closed ring of faces, or faces as large as one; small faces on no ring (the
     # sides of a dormer, a balcony's front...) are parts of something else and are left out
     def area(ring):
         return sum(f.width * f.height for f in ring)
 
     largest = max(area(r) for r in rings)
-    closed = [ring for ring in rings
-              if all(f.left != "free" and f.right != "free" for f in ring) or area(ring) >= 0.25 * largest]
+    closed = [
+        ring
+        for ring in rings
+        if all(f.left != "free" and f.right != "free" for f in ring) or area(ring) >= 0.25 * largest
+    ]
     dropped = sum(len(r) for r in rings) - sum(len(r) for r in closed)
     blocks = []
     for i, ring in enumerate(closed or rings):
         xs = [c for f in ring for c in (f.origin[0], f.origin[0] + f.width * f.x_axis[0])]
         zs = [c for f in ring for c in (f.origin[2], f.origin[2] + f.width * f.x_axis[2])]
-        blocks.append(Block(f"Block{i}", ring, max(xs) - min(xs), max(zs) - min(zs),
-                            max(f.height for f in ring), footprint=[(f.origin[0], f.origin[2]) for f in ring]))
+        blocks.append(
+            Block(
+                f"Block{i}",
+                ring,
+                max(xs) - min(xs),
+                max(zs) - min(zs),
+                max(f.height for f in ring),
+                footprint=[(f.origin[0], f.origin[2]) for f in ring],
+            )
+        )
     colors: dict[str, str] = {}
     for t in terminals:  # a label's colour: the first one it comes in
         if t.color is not None:
