@@ -15,8 +15,9 @@ import random
 import statistics
 import time
 
-import bgr
 from bgr.grammar.parser import parse
+
+import bgr
 
 
 def generate(lines: int = 5000, seed: int = 0) -> str:

@@ -20,7 +20,6 @@ import time
 from pathlib import Path
 
 import numpy as np
-
 from bgr.interpreter.terminals import TerminalTable, UnitMesh
 from bgr.interpreter.writers import write
 from bgr.interpreter.writers.glb import write_glb

@@ -8,7 +8,8 @@ The public Python API::
     result = bgr.derive(grammar, seed=3)     # terminals as a table; result.save("house.glb")
 """
 
-from importlib.metadata import PackageNotFoundError, version as _version
+from importlib.metadata import PackageNotFoundError
+from importlib.metadata import version as _version
 
 from .grammar.checker import Grammar
 from .grammar.errors import BgrCheckError, BgrError, BgrSyntaxError, Diagnostic

@@ -17,12 +17,12 @@ import time
 from pathlib import Path
 
 import numpy as np
-from PIL import Image, ImageDraw
-
-import bgr
 from bgr.grammar.stdlib_reference import MODULES, public_rules, stdlib_markdown, thumbnail_path
 from bgr.render import load_scene, render, save_png
 from bgr.render.camera import Camera, fit, rotation_from_angles
+from PIL import Image, ImageDraw
+
+import bgr
 
 DOCS = Path(__file__).resolve().parent
 ROOT = DOCS.parent

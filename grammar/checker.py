@@ -23,6 +23,8 @@ from .registry import (
     COMP_KIND,
     COMP_KINDS,
     COMP_SELECTORS,
+    FOOTPRINT_KIND,
+    FOOTPRINT_KINDS,
     GEOMETRY,
     KEYWORDS,
     NUMBER,
@@ -34,8 +36,6 @@ from .registry import (
     SIZE,
     STRING,
     Op,
-    FOOTPRINT_KIND,
-    FOOTPRINT_KINDS,
 )
 
 KNOWN_VERSIONS = (1,)
@@ -65,11 +65,11 @@ class Grammar:
     consts: dict[str, n.Const] = field(default_factory=dict)
     funcs: dict[str, n.Func] = field(default_factory=dict)
     assets: dict[str, n.Asset] = field(default_factory=dict)
-    imports: dict[str, "Grammar"] = field(default_factory=dict)
+    imports: dict[str, Grammar] = field(default_factory=dict)
     start: str | None = None
     version: int = 1
 
-    def lookup_module(self, dotted: str) -> tuple["Grammar", str]:
+    def lookup_module(self, dotted: str) -> tuple[Grammar, str]:
         """Split ``alias.Name`` into (module, member); a plain name is this module's own."""
         if "." in dotted:
             alias, member = dotted.split(".", 1)

@@ -8,8 +8,9 @@ directly and print them with :mod:`bgr.grammar.formatter`.
 
 from __future__ import annotations
 
+from collections.abc import Iterator
 from dataclasses import dataclass, field
-from typing import Iterator, Union
+from typing import Union
 
 
 @dataclass(frozen=True)
@@ -325,7 +326,7 @@ class Module:
         return [item for item in self.items if isinstance(item, Rule)]
 
 
-def names_in(expr) -> "Iterator[Name]":
+def names_in(expr) -> Iterator[Name]:
     """Every Name inside an expression, without recursion (operator chains can be long)."""
     stack = [expr]
     while stack:

@@ -557,13 +557,13 @@ _DECLARATIONS = {
 def _describe_expected(expected: set[str]) -> list[str]:
     expected = set(expected)
     words = []
-    if _DECLARATIONS <= expected:
+    if expected >= _DECLARATIONS:
         words.append("a declaration or a rule")
         expected -= _DECLARATIONS
-    if _EXPRESSION_START <= expected:
+    if expected >= _EXPRESSION_START:
         words.append("an expression")
         expected -= _EXPRESSION_START | {"QUOTE"}
-    if _STEP_START <= expected:
+    if expected >= _STEP_START:
         words.append("an operation or a successor")
         expected -= _STEP_START
     parser = _lark()

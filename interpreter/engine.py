@@ -11,6 +11,8 @@ from __future__ import annotations
 import gc
 
 from bgr.grammar import nodes as n
+from bgr.grammar.checker import bind_problem
+from bgr.grammar.errors import BgrError, Diagnostic, suggest
 from bgr.grammar.registry import (
     AXES,
     AXIS,
@@ -21,17 +23,13 @@ from bgr.grammar.registry import (
     ROOF_KIND,
 )
 
-from bgr.grammar.errors import BgrError, Diagnostic, suggest
-
-from bgr.grammar.checker import bind_problem
-
 from .expressions import Compiler, Context, RuleRef, evaluate_values, runtime_error
-from .randomness import Stream, child_hash, name_hash, root_hash
-from .shapes import Flat, Shape, Solid
-from .terminals import TerminalTable, UnitMesh
 from .geometry import meshes
 from .geometry.polygons import RECT
 from .operations import IMPLEMENTATIONS
+from .randomness import Stream, child_hash, name_hash, root_hash
+from .shapes import Flat, Shape, Solid
+from .terminals import TerminalTable, UnitMesh
 
 SYMBOL_KINDS = {AXIS, AXES, COMP_KIND, ROOF_KIND, FOOTPRINT_KIND, GEOMETRY}
 EMIT = object()  # marks a children-list entry that is a finished terminal, kept in order

@@ -9,8 +9,9 @@ from __future__ import annotations
 
 import math
 import operator
+from collections.abc import Callable
 from pathlib import Path
-from typing import Any, Callable
+from typing import Any
 
 from bgr.grammar import nodes as n
 from bgr.grammar.errors import BgrError, Diagnostic, source_line
@@ -138,7 +139,7 @@ _MATH = {
 class Compiler:
     """Compiles the expressions of one checked module (a :class:`bgr.Grammar`)."""
 
-    def __init__(self, module, values: dict[str, Value], modules: dict[int, "Compiler"]) -> None:
+    def __init__(self, module, values: dict[str, Value], modules: dict[int, Compiler]) -> None:
         self.module = module  # the checked Grammar
         self.values = values  # attrs and consts of this module, already evaluated
         self.modules = modules  # id(Grammar) -> Compiler, for imported names

@@ -82,7 +82,7 @@ class Shape:
         self.depth = depth
         self.frame = None  # (origin, axes) of the shape this one was cut from; None: the world
 
-    def copy(self) -> "Shape":
+    def copy(self) -> Shape:
         twin = Shape(
             self.origin,
             self.axes,
@@ -98,7 +98,7 @@ class Shape:
         twin.frame = self.frame
         return twin
 
-    def cut_from(self, parent: "Shape") -> "Shape":
+    def cut_from(self, parent: Shape) -> Shape:
         """Mark this shape as a piece of ``parent`` (a split piece, a face, an inset)."""
         self.frame = (tuple(parent.origin), parent.axes)
         return self

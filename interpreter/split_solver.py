@@ -31,7 +31,7 @@ class Piece:
 
 @dataclass(frozen=True)
 class Repeat:
-    items: tuple["Item", ...]
+    items: tuple[Item, ...]
 
 
 Item = Union[Piece, Repeat]

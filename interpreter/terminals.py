@@ -66,7 +66,7 @@ class TerminalTable:
     def __len__(self) -> int:
         return len(self.label)
 
-    def freeze(self) -> "TerminalTable":
+    def freeze(self) -> TerminalTable:
         if not self.frozen:
             self.origin = np.asarray(self.origin, dtype=np.float64).reshape(-1, 3)
             self.axes = np.asarray(self.axes, dtype=np.float64).reshape(-1, 3, 3)

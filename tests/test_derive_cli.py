@@ -5,9 +5,8 @@ import subprocess
 import sys
 
 import pytest
-from pygltflib import GLTF2
-
 from conftest import ROOT
+from pygltflib import GLTF2
 
 
 def bgr(*args, cwd=None):

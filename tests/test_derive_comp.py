@@ -5,9 +5,9 @@ import json
 
 import numpy as np
 import pytest
+from bgr.interpreter.writers import write_json
 
 import bgr
-from bgr.interpreter.writers import write_json
 
 BOX = """Lot --> extrude(4) comp(f) { front: F | back: B | left: L | right: R | top: T | bottom: Bo }
 terminal F, B, L, R, T, Bo

@@ -7,10 +7,10 @@ import math
 
 import numpy as np
 import pytest
+from bgr.interpreter.terminals import world_vertices
 from shapely.geometry import LineString, Point, Polygon
 
 import bgr
-from bgr.interpreter.terminals import world_vertices
 
 FOOTPRINTS = {
     "rect": [(0, 0), (16, 0), (16, 10), (0, 10)],
@@ -119,7 +119,6 @@ def test_roof_eaves_are_the_wall_tops(tmp_path, name, kind):
 )
 def test_closed_form_rectangle_hip_matches_the_straight_skeleton(w, d, overhang):
     import trimesh
-
     from bgr.interpreter.geometry.rect_roofs import rectangle_hip
     from bgr.interpreter.geometry.roofs import roof_mesh
 

@@ -4,10 +4,10 @@ import io
 import json
 
 import pytest
+from bgr.interpreter.split_solver import Piece, Repeat, solve
+from bgr.interpreter.writers import write_json
 
 import bgr
-from bgr.interpreter.writers import write_json
-from bgr.interpreter.split_solver import Piece, Repeat, solve
 
 
 def pieces(block: str, length: float = 10.0):

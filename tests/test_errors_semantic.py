@@ -13,9 +13,7 @@ import subprocess
 import sys
 
 import pytest
-
 from errors_helpers import check, first_error
-
 
 # (source, line, column, message substring, hint substring or None)
 CASES = [

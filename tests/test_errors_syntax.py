@@ -8,9 +8,9 @@ Tests marked xfail(strict=True) describe the right behaviour where the implement
 from __future__ import annotations
 
 import pytest
+from errors_helpers import check, first_error
 
 import bgr
-from errors_helpers import check, first_error
 
 # Words that must never reach a user: Lark's terminal names and Python internals.
 LARK_WORDS = (

@@ -5,7 +5,6 @@ import subprocess
 import sys
 
 import pytest
-
 from bgr.interpreter.writers import read_glb
 from conftest import ROOT
 

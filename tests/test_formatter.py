@@ -1,10 +1,10 @@
 """The formatter: canonical layout, comments kept, idempotent, meaning unchanged."""
 
 import pytest
-
-from bgr import format_module, format_source, parse
 from bgr.grammar import nodes as n
 from conftest import SHARED, shipped_grammars
+
+from bgr import format_module, format_source, parse
 
 
 @pytest.mark.parametrize("path", shipped_grammars(), ids=lambda p: p.name)

@@ -27,13 +27,6 @@ import sys
 from pathlib import Path
 
 import pytest
-from hypothesis import HealthCheck, given, note, settings
-from hypothesis import strategies as st
-from hypothesis.errors import InvalidArgument
-
-import bgr
-from bgr import BgrError
-from bgr.cli import main
 from bgr.grammar import nodes as n
 from bgr.grammar.formatter import format_module, format_source
 from bgr.grammar.parser import parse
@@ -48,6 +41,13 @@ from bgr.grammar.registry import (
     PRIMITIVES,
     ROOF_KINDS,
 )
+from hypothesis import HealthCheck, given, note, settings
+from hypothesis import strategies as st
+from hypothesis.errors import InvalidArgument
+
+import bgr
+from bgr import BgrError
+from bgr.cli import main
 
 ROOT = Path(__file__).resolve().parent.parent
 BENCH = Path(os.environ.get("BGR_BENCH_GRAMMAR", "/work/shared/bench/grid_city.bgr"))

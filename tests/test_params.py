@@ -3,11 +3,11 @@
 
 import numpy as np
 import pytest
+from bgr.interpreter.terminals import color_hex
+from errors_helpers import check
 
 import bgr
 from bgr import format_source
-from bgr.interpreter.terminals import color_hex
-from errors_helpers import check
 
 
 def derive(src, **kw):

@@ -15,8 +15,6 @@ from collections import Counter
 import numpy as np
 import pytest
 import shapely
-from shapely.geometry import LineString, Polygon
-
 from bgr.interpreter.geometry.earclip import triangulate
 from bgr.interpreter.geometry.roofs import (
     KINDS,
@@ -26,6 +24,7 @@ from bgr.interpreter.geometry.roofs import (
     roof_mesh,
 )
 from bgr.interpreter.geometry.skeleton import offset_outward, straight_skeleton
+from shapely.geometry import LineString, Polygon
 
 trimesh = pytest.importorskip("trimesh")
 
@@ -53,7 +52,7 @@ def edge_frame(poly: np.ndarray, i: int):
     return a, np.array([-d[1], d[0]])
 
 
-def capped(mesh: RoofMesh) -> "trimesh.Trimesh":
+def capped(mesh: RoofMesh) -> trimesh.Trimesh:
     """The roof closed with a downward cap on its eave outline."""
     cap = triangulate(mesh.eave[:, :2])[:, ::-1] + len(mesh.vertices)
     return trimesh.Trimesh(

@@ -8,7 +8,7 @@ along (a lot: y, a façade face: z) or extruded along (a prism).
 from __future__ import annotations
 
 import math
-from functools import lru_cache
+from functools import cache
 
 import numpy as np
 
@@ -95,7 +95,7 @@ def _inside(pt, ext, holes) -> bool:
     return in_ring(ext) and not any(in_ring(h) for h in holes)
 
 
-@lru_cache(maxsize=None)
+@cache
 def primitive(name: str) -> tuple[np.ndarray, np.ndarray]:
     """The unit meshes of i(): cube, quad, wedge, cylinder (y up), sphere."""
     if name == "cube":

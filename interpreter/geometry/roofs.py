@@ -160,7 +160,7 @@ class _Footprint:
     scale: float
 
     @classmethod
-    def of(cls, polygon) -> "_Footprint":
+    def of(cls, polygon) -> _Footprint:
         pts = np.asarray(polygon, dtype=np.float64)
         if pts.ndim != 2 or pts.shape[1] != 2 or len(pts) < 3:
             raise ValueError("a roof footprint is a (K, 2) array of K >= 3 points")

@@ -5,7 +5,6 @@ from __future__ import annotations
 import math
 
 import numpy as np
-
 from bgr.grammar import nodes as n
 
 from ..expressions import runtime_error
@@ -16,12 +15,13 @@ from ..geometry.polygons import (
     inset,
     is_unit_square,
     named_footprint,
-    normalise as normalise_polys,
     signed_area,
+)
+from ..geometry.polygons import (
+    normalise as normalise_polys,
 )
 from ..shapes import Flat, Prism, Solid, cross, dot, normalise
 from ..terminals import UnitMesh
-
 
 # ---- comp(f) -----------------------------------------------------------------------------------
 

@@ -29,7 +29,7 @@ class MeshPool:
     fcount: np.ndarray
 
     @classmethod
-    def of(cls, table: TerminalTable) -> "MeshPool":
+    def of(cls, table: TerminalTable) -> MeshPool:
         meshes = table.library.meshes
         verts = [m.vertices for m in meshes] or [np.zeros((0, 3))]
         faces = [m.faces for m in meshes] or [np.zeros((0, 3), dtype=np.int64)]

@@ -44,13 +44,13 @@ def write_obj(
     names = obj_names(mats)
     rows = np.argsort(mats.index, kind="stable")
     baked = bake(table, rows)
-    stream.write(f"# bgr seed {seed}\nmtllib {mtl_name}\n".encode("utf-8"))
+    stream.write(f"# bgr seed {seed}\nmtllib {mtl_name}\n".encode())
     _rows(stream, "v %.9g %.9g %.9g\n", baked.vertices)
     mat_of_face = np.repeat(mats.index[rows], np.diff(baked.fstart))
     cuts = np.flatnonzero(np.diff(mat_of_face)) + 1
     for lo, hi in zip(np.concatenate([[0], cuts]), np.concatenate([cuts, [len(mat_of_face)]])):
         if hi > lo:
-            stream.write(f"usemtl {names[mat_of_face[lo]]}\n".encode("utf-8"))
+            stream.write(f"usemtl {names[mat_of_face[lo]]}\n".encode())
             _rows(stream, "f %d %d %d\n", baked.faces[lo:hi] + 1)
     lines = ["# bgr materials"]
     for k, name in enumerate(names):
