@@ -17,10 +17,9 @@ import math
 import statistics
 import time
 
+import bgr
 from bgr.interpreter.writers import write_json
 from bgr.inverse.schema import infer
-
-import bgr
 
 GRAMMAR = """\
 attr W = 30
@@ -64,7 +63,8 @@ def main() -> None:
             times.append(time.perf_counter() - start)
         rules = sum(1 for item in module.items if type(item).__name__ == "Rule")
         print(
-            f"{count:8,d}  {statistics.median(times):8.3f}  {min(times):6.3f}  {rules:5d}  {grammar.count(chr(10)):5d}"
+            f"{count:8,d}  {statistics.median(times):8.3f}  {min(times):6.3f}  {rules:5d}  "
+            f"{grammar.count(chr(10)):5d}"
         )
 
 

@@ -1,6 +1,7 @@
 """Benchmark: render a 200,000-triangle model at 1024 x 1024 with both rasterisers.
 
-    python bench/render.py [--n 9] [--size 1024] [--repeats 5] [--grammar ../shared/bench/grid_city.bgr]
+    python bench/render.py [--n 9] [--size 1024] [--repeats 5]
+                           [--grammar ../shared/bench/grid_city.bgr]
 
 The model is the grid-city stress grammar (bench/grid_city.py) with n = 9: 81 buildings, 200,086
 triangles.  For each backend (GL through EGL, numpy) and each view it times, over several
@@ -46,9 +47,8 @@ def main() -> None:
     if not args.grammar.is_file():
         sys.exit(f"{args.grammar}: not found (the benchmark grammar lives in ../shared/bench/)")
 
-    from bgr.render import Camera, images, load_scene, raster_gl, raster_numpy
-
     import bgr
+    from bgr.render import Camera, images, load_scene, raster_gl, raster_numpy
 
     t = time.perf_counter()
     result = bgr.derive(bgr.load(args.grammar), seed=1, attrs={"n": args.n})
@@ -58,8 +58,10 @@ def main() -> None:
     scene_s = time.perf_counter() - t
     size = (args.size, args.size)
     print(
-        f"model: {args.grammar.name} n = {args.n}: {len(result):,} terminals, {len(scene):,} triangles "
-        f"(derive {derive_s:.2f} s, scene {scene_s:.2f} s); image {size[0]}x{size[1]}; cores: {os.cpu_count()}"
+        f"model: {args.grammar.name} n = {args.n}: {len(result):,} terminals, {len(scene):,} "
+        "triangles "
+        f"(derive {derive_s:.2f} s, scene {scene_s:.2f} s); image {size[0]}x{size[1]}; cores: "
+        f"{os.cpu_count()}"
     )
 
     t = time.perf_counter()
@@ -68,7 +70,8 @@ def main() -> None:
     if gl:
         info = raster_gl._context()["ctx"].info
         print(
-            f"GL: {info['GL_RENDERER']}, {info['GL_VERSION']}; context made in {context_s:.2f} s (once per process)"
+            f"GL: {info['GL_RENDERER']}, {info['GL_VERSION']}; context made in {context_s:.2f} s "
+            "(once per process)"
         )
     else:
         print(f"GL: not available ({raster_gl._state.get('error')}); numpy only")
@@ -88,7 +91,8 @@ def main() -> None:
                 lambda r=rasterise, c=cam: images.shaded(r(scene.triangles, c), scene), args.repeats
             )
             print(
-                f"{name:<8} {view:<6} {frame.mask.mean():>7.1%} {raster[0]:>13.3f} {raster[1]:>7.3f} "
+                f"{name:<8} {view:<6} {frame.mask.mean():>7.1%} {raster[0]:>13.3f} "
+                f"{raster[1]:>7.3f} "
                 f"{whole[0]:>13.3f} {whole[1]:>7.3f}"
             )
 
@@ -96,7 +100,8 @@ def main() -> None:
         glb = Path(tmp) / "city.glb"
         result.save(glb)
         print(
-            f"\ncommand line, fresh process each: bgr render city.glb -o x.png --size {size[0]}x{size[1]}"
+            "\ncommand line, fresh process each: bgr render city.glb -o x.png --size "
+            f"{size[0]}x{size[1]}"
         )
         for name, _ in backends:
             cmd = [
@@ -120,7 +125,8 @@ def main() -> None:
                 if proc.returncode != 0:
                     sys.exit(proc.stderr)
             print(
-                f"  --backend {name:<6} median {statistics.median(runs):.2f} s, best {min(runs):.2f} s"
+                f"  --backend {name:<6} median {statistics.median(runs):.2f} s, best "
+                f"{min(runs):.2f} s"
             )
 
 

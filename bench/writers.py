@@ -12,6 +12,7 @@ writing the file) and the file sizes.  Target (issue): 1M triangles in about 0.2
 from __future__ import annotations
 
 import argparse
+import functools
 import os
 import platform
 import statistics
@@ -20,6 +21,7 @@ import time
 from pathlib import Path
 
 import numpy as np
+
 from bgr.interpreter.terminals import TerminalTable, UnitMesh
 from bgr.interpreter.writers import write
 from bgr.interpreter.writers.glb import write_glb
@@ -83,6 +85,14 @@ def timed(fn, repeat: int) -> tuple[float, float]:
     return statistics.median(runs), min(runs)
 
 
+def _glb(t, path: Path, instancing) -> None:
+    if instancing == "auto":
+        write(t, path, seed=0, attrs={})
+    else:  # the same atomic path, with instancing off
+        with open(path, "wb") as f:
+            write_glb(t, f, seed=0, attrs={}, instancing=False)
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--triangles", type=int, default=1_000_000)
@@ -106,21 +116,14 @@ def main() -> None:
         for label, instancing in [("instanced (auto)", "auto"), ("no instancing", False)]:
             path = Path(tmp) / f"bench_{instancing}.glb"
 
-            def run():
-                if instancing == "auto":
-                    write(t, path, seed=0, attrs={})
-                else:  # the same atomic path, with instancing off
-                    with open(path, "wb") as f:
-                        write_glb(t, f, seed=0, attrs={}, instancing=False)
-
-            median, best = timed(run, args.repeat)
+            median, best = timed(functools.partial(_glb, t, path, instancing), args.repeat)
             print(
                 f"glb {label:17s}: median {median:.3f} s, best {best:.3f} s, "
                 f"{path.stat().st_size / 1e6:.1f} MB"
             )
         for ext in ["json", "ply", "stl", "obj"]:
             path = Path(tmp) / f"bench.{ext}"
-            median, best = timed(lambda: write(t, path, seed=0, attrs={}), 1)
+            median, best = timed(functools.partial(write, t, path, seed=0, attrs={}), 1)
             print(f"{ext:21s}: {median:.3f} s, {path.stat().st_size / 1e6:.1f} MB")
 
 

@@ -317,7 +317,8 @@ def cmd_derive(args) -> int:
             result.terminals, Path(args.output), seed=args.seed, attrs=result.attrs, fmt=args.format
         )
         print(
-            f"{args.output}: {len(result):,} terminals, {result.terminals.triangle_count():,} triangles",
+            f"{args.output}: {len(result):,} terminals, {result.terminals.triangle_count():,} "
+            "triangles",
             file=sys.stderr,
         )
     return EXIT_OK
@@ -429,7 +430,8 @@ def cmd_render(args) -> int:
     width, height = camera.size
     view = args.view if args.view in VIEWS else Path(args.view).name
     print(
-        f"{args.output}: {width}x{height} {args.mode}, view {view}, {len(scene):,} triangles ({frame.backend})",
+        f"{args.output}: {width}x{height} {args.mode}, view {view}, {len(scene):,} triangles "
+        f"({frame.backend})",
         file=sys.stderr,
     )
     return EXIT_OK

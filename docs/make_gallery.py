@@ -1,6 +1,6 @@
 """Render the README gallery and the standard-library thumbnails with bgr's own renderer.
 
-    python docs/make_gallery.py            # everything: examples, thumbnails, contact sheet, stdlib.md
+    python docs/make_gallery.py     # everything: examples, thumbnails, contact sheet, stdlib.md
     python docs/make_gallery.py --only examples
 
 Writes docs/img/examples/*.png (the examples, as the README shows them), one thumbnail per public
@@ -17,12 +17,12 @@ import time
 from pathlib import Path
 
 import numpy as np
-from bgr.grammar.stdlib_reference import MODULES, public_rules, stdlib_markdown, thumbnail_path
-from bgr.render import load_scene, render, save_png
-from bgr.render.camera import Camera, fit, rotation_from_angles
 from PIL import Image, ImageDraw
 
 import bgr
+from bgr.grammar.stdlib_reference import MODULES, public_rules, stdlib_markdown, thumbnail_path
+from bgr.render import load_scene, render, save_png
+from bgr.render.camera import Camera, fit, rotation_from_angles
 
 DOCS = Path(__file__).resolve().parent
 ROOT = DOCS.parent

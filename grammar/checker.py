@@ -8,6 +8,7 @@ the already-checked imported modules as :class:`Grammar` objects.
 from __future__ import annotations
 
 import re
+from collections.abc import Set as AbstractSet
 from dataclasses import dataclass, field
 
 from . import nodes as n
@@ -110,7 +111,7 @@ class Checker:
     def check(self) -> list[Diagnostic]:
         self.collect()
         for item in self.g.module.items:
-            if isinstance(item, n.Attr) or isinstance(item, n.Const):
+            if isinstance(item, (n.Attr, n.Const)):
                 self.expr(item.value, set(), in_rule=False)
             elif isinstance(item, n.Func):
                 self.expr(item.body, set(item.params), in_rule=True)
@@ -174,13 +175,15 @@ class Checker:
                     if declare("rule", name, item.pos, "rule or terminal"):
                         g.terminals[name] = item.pos
             elif isinstance(item, (n.Attr, n.Const)):
-                what = "attr" if isinstance(item, n.Attr) else "const"
                 if item.name in BUILTIN_NAMES:
                     self.error(
                         item.pos, f"'{item.name}' is a built-in name and cannot be redefined"
                     )
                 elif declare("value", item.name, item.pos, "attr or const"):
-                    (g.attrs if what == "attr" else g.consts)[item.name] = item
+                    if isinstance(item, n.Attr):
+                        g.attrs[item.name] = item
+                    else:
+                        g.consts[item.name] = item
             elif isinstance(item, n.Func):
                 if item.name in BUILTINS:
                     self.error(
@@ -249,7 +252,7 @@ class Checker:
 
     # ---- rules ----------------------------------------------------------------------------
     def rule(self, rule: n.Rule) -> None:
-        for i, p in enumerate(rule.params):  # a default sees the parameters before it
+        for i, _p in enumerate(rule.params):  # a default sees the parameters before it
             default = rule.default(i)
             if default is not None and not self.is_rule_ref(default):
                 self.expr(default, set(rule.params[:i]), in_rule=True)
@@ -294,8 +297,10 @@ class Checker:
             for inner in step.steps:
                 self.step(inner, local)
 
-    def is_rule_ref(self, e, local: set[str] = frozenset()) -> bool:
-        """A bare name of a rule or terminal, handed whole to a rule parameter (``window = Arched``)."""
+    def is_rule_ref(self, e, local: AbstractSet[str] = frozenset()) -> bool:
+        """A bare name of a rule or terminal, handed whole to a rule parameter (``window =
+        Arched``).
+        """
         if not isinstance(e, n.Name) or e.name in local:
             return False
         module, member = self.g.lookup_module(e.name)
@@ -374,7 +379,7 @@ class Checker:
         op = OPERATIONS[step.name]
         signature = self.pick_signature(op, step)
         if signature is not None:
-            for arg, param in zip(step.args, signature):
+            for arg, param in zip(step.args, signature, strict=False):
                 self.op_arg(arg, param.kind, param.name, op, local)
         else:
             for arg in step.args:
@@ -403,7 +408,7 @@ class Checker:
 
     def pick_signature(self, op: Op, step: n.Operation):
         count = len(step.args)
-        for sig, (least, most) in zip(op.signatures, op.arities()):
+        for sig, (least, most) in zip(op.signatures, op.arities(), strict=True):
             if least <= count <= most:
                 return sig
         counts = " or ".join(str(a) if a == b else f"{a} to {b}" for a, b in op.arities())
@@ -682,7 +687,7 @@ class Checker:
 
     def value_cycles(self) -> None:
         """attr a = b + 1; attr b = a: report a definition cycle among attrs and consts."""
-        values = {**self.g.attrs, **self.g.consts}
+        values: dict[str, n.Attr | n.Const] = {**self.g.attrs, **self.g.consts}
         deps = {
             name: {x.name for x in n.names_in(item.value) if x.name in values}
             for name, item in values.items()

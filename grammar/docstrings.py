@@ -73,7 +73,7 @@ def module_header(module: n.Module) -> str:
     first_item = min(
         (item.pos.line for item in module.items if getattr(item, "pos", None)), default=10**9
     )
-    out = []
+    out: list[tuple[int, str]] = []
     for c in sorted(module.comments, key=lambda c: c.line):
         if c.line >= first_item or not c.own_line:
             break

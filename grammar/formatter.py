@@ -19,6 +19,7 @@ from __future__ import annotations
 
 import bisect
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 from . import nodes as n
@@ -232,7 +233,7 @@ class Formatter:
         if isinstance(item, n.Version):
             return f"version {format_number(item.number)}"
         if isinstance(item, n.Import):
-            target = item.module if item.module is not None else format_string(item.path)
+            target = item.module if item.module is not None else format_string(item.path or "")
             return f"import {target} as {item.alias}"
         if isinstance(item, n.Attr):
             return f"attr {item.name} = {format_expr(item.value)}"
@@ -266,12 +267,16 @@ class Formatter:
             out.write(head + " ")
             self.steps(body.steps, out)
             return
-        alts = body.choices if isinstance(body, n.Stochastic) else body.cases
+        alts: Sequence[n.Choice | n.Case] = (
+            body.choices if isinstance(body, n.Stochastic) else body.cases
+        )
         heads = [self.alt_head(a) for a in alts]
         inline = (
             head
             + " "
-            + " | ".join(h + self.inline_steps(a.body.steps) for h, a in zip(heads, alts))
+            + " | ".join(
+                h + self.inline_steps(a.body.steps) for h, a in zip(heads, alts, strict=True)
+            )
         )
         # Branches have no closing bracket, so a comment after the last one also keeps them
         # one per line once they already start below the head (that is how fmt wrote them).
@@ -287,7 +292,7 @@ class Formatter:
             out.write(inline)
             return
         out.write(head)
-        for i, (h, alt) in enumerate(zip(heads, alts)):
+        for i, (h, alt) in enumerate(zip(heads, alts, strict=True)):
             out.start(alt.pos.line or rule.pos.line, 1)
             out.write(("| " if i else "") + h)
             self.steps(alt.body.steps, out)
@@ -401,7 +406,7 @@ class Formatter:
         return placed + tail
 
     def render(self, lines: list[Line]) -> str:
-        text = []
+        text: list[str] = []
         for line in lines:
             if line.top and text and text[-1] != "" and self.blank_before(line.anchor):
                 text.append("")

@@ -127,7 +127,7 @@ class Loader:
                 return None
             shown = f"stdlib/{parts[1]}.bgr"
         else:
-            target = folder / item.path
+            target = folder / (item.path or "")  # the parser sets path when module is None
             shown = _display(target)
             if not target.is_file():
                 fail(f"cannot find the imported file '{item.path}'", f"looked for {target}")

@@ -10,7 +10,6 @@ from __future__ import annotations
 
 from collections.abc import Iterator
 from dataclasses import dataclass, field
-from typing import Union
 
 
 @dataclass(frozen=True)
@@ -93,7 +92,7 @@ class Ternary:
 
 @dataclass
 class Relative:
-    """``'expr`` as an operation argument: a fraction of the current scope size (``s('0.5, 0, 0)``)."""
+    """``'expr`` as an operation argument: a fraction of the scope size (``s('0.5, 0, 0)``)."""
 
     expr: Expr
     pos: Pos = _pos()
@@ -101,15 +100,15 @@ class Relative:
 
 @dataclass
 class Keyword:
-    """``name = expr`` as a successor argument: binds the rule parameter ``name`` (``Tile(w = 2)``)."""
+    """``name = expr`` as a successor argument: binds rule parameter ``name`` (``Tile(w = 2)``)."""
 
     name: str
     value: Expr
     pos: Pos = _pos()
 
 
-Expr = Union[Number, String, Bool, Name, Call, Unary, Binary, Ternary]
-Arg = Union[Expr, Relative, Keyword]
+Expr = Number | String | Bool | Name | Call | Unary | Binary | Ternary
+Arg = Expr | Relative | Keyword
 
 
 # ---- rule bodies -----------------------------------------------------------------------------
@@ -147,7 +146,7 @@ class Nil:
     pos: Pos = _pos()
 
 
-Step = Union[Operation, Successor, Push, Nil]
+Step = Operation | Successor | Push | Nil
 
 
 @dataclass
@@ -181,8 +180,10 @@ class Group:
 
 @dataclass
 class Block:
-    """The ``{ ... }`` of split, comp and offset.  ``repeat`` is the ``split(x) { ... }*`` shorthand,
-    which means the whole block is one repeat group."""
+    """The ``{ ... }`` of split, comp and offset.
+
+    ``repeat`` is the ``split(x) { ... }*`` shorthand: the whole block is one repeat group.
+    """
 
     entries: list[Entry | Group]
     repeat: bool = False
@@ -219,7 +220,7 @@ class Conditional:
     pos: Pos = _pos()
 
 
-Body = Union[Sequence, Stochastic, Conditional]
+Body = Sequence | Stochastic | Conditional
 
 
 # ---- top-level items -------------------------------------------------------------------------
@@ -249,7 +250,10 @@ class Version:
 
 @dataclass
 class Import:
-    """``import "lib/w.bgr" as w`` (``path`` set) or ``import stdlib.facade as fac`` (``module``)."""
+    """An import: ``import "lib/w.bgr" as w`` (sets ``path``) or ``import stdlib.facade as fac``.
+
+    The alias names the module in rule references (``w.Window``).
+    """
 
     alias: str
     path: str | None = None
@@ -300,7 +304,7 @@ class Start:
     pos: Pos = _pos()
 
 
-Item = Union[Version, Import, Attr, Const, Func, Asset, TerminalDecl, Start, Rule]
+Item = Version | Import | Attr | Const | Func | Asset | TerminalDecl | Start | Rule
 
 
 @dataclass

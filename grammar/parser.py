@@ -12,6 +12,7 @@ import gc
 import math
 import threading
 from pathlib import Path
+from typing import cast
 
 from lark import Lark, Token, Transformer
 from lark.exceptions import UnexpectedCharacters, UnexpectedEOF, UnexpectedInput
@@ -60,8 +61,14 @@ def _span(*children) -> n.Pos:
     return n.Pos(start[0], start[1], *(end or start))
 
 
+def _token_line_col(tok: Token) -> tuple[int, int]:
+    """A token's line and column; Lark types them optional, but every lexed token has them."""
+    return tok.line or 0, tok.column or 0
+
+
 def _tok_pos(tok: Token) -> n.Pos:
-    return n.Pos(tok.line, tok.column, tok.end_line or tok.line, tok.end_column or tok.column)
+    line, column = _token_line_col(tok)
+    return n.Pos(line, column, tok.end_line or line, tok.end_column or column)
 
 
 def _keywords_last(args: list) -> None:
@@ -107,7 +114,8 @@ def _unescape(tok: Token) -> str:
         if c == "\\":
             nxt = body[i + 1]
             if nxt not in escapes:
-                pos = n.Pos(tok.line, tok.column + i + 1, tok.line, tok.column + i + 2)
+                line, column = _token_line_col(tok)
+                pos = n.Pos(line, column + i + 1, line, column + i + 2)
                 raise _Problem(
                     pos,
                     f"unknown escape '\\{nxt}' in a string",
@@ -377,6 +385,7 @@ class _Pratt:
     def parse(self, min_bp: int = 0):
         tok = self.stream[self.i]
         self.i += 1
+        left: n.Expr
         if isinstance(tok, Token):  # a prefix operator
             operand = self.parse(_PREFIX[str(tok)])
             if str(tok) == "-" and isinstance(operand, n.Number):  # -0.25 is a number literal
@@ -479,7 +488,8 @@ def parse(text: str, path: str = "<text>") -> n.Module:
     with _lock, _no_gc():
         _comments.tokens = []
         try:
-            items = _lark().parse(text)
+            # the inline transformer builds the module items: a list, though Lark types a Tree
+            items = cast("list[n.Item]", _lark().parse(text))
         except RecursionError:
             raise BgrSyntaxError(
                 Diagnostic(
@@ -509,8 +519,9 @@ def parse(text: str, path: str = "<text>") -> n.Module:
     comments = []
     lines = source_lines(text)
     for tok in tokens:
-        before = lines[tok.line - 1][: tok.column - 1] if tok.line <= len(lines) else ""
-        comments.append(n.Comment(str(tok).rstrip(), tok.line, tok.column, not before.strip()))
+        line, column = _token_line_col(tok)
+        before = lines[line - 1][: column - 1] if line <= len(lines) else ""
+        comments.append(n.Comment(str(tok).rstrip(), line, column, not before.strip()))
     return n.Module(items, path=path, comments=comments, source=text)
 
 
@@ -605,7 +616,10 @@ def _hint(tok: Token | None, expected: set[str]) -> str | None:
     if tok.type == "$END" and expected & {"RPAR", "RBRACE", "RSQB"}:
         return "a bracket is not closed"
     if tok.type in ("QUOTE", "TILDE"):
-        return "relative sizes ('0.5) go in s(), t() and split blocks; floating sizes (~2) in split blocks"
+        return (
+            "relative sizes ('0.5) go in s(), t() and split blocks; "
+            "floating sizes (~2) in split blocks"
+        )
     if tok.type == "COLON" and "PERCENT" in expected:
         return "a stochastic choice is written '60%: A'"
     if tok.type == "EQUAL" and "BINOP" in expected:
@@ -616,7 +630,8 @@ def _hint(tok: Token | None, expected: set[str]) -> str | None:
 def _translate(e: UnexpectedInput, text: str, path: str) -> BgrSyntaxError:
     line, column = getattr(e, "line", 0), getattr(e, "column", 0)
     if isinstance(e, UnexpectedCharacters):
-        char = text[e.pos_in_stream] if e.pos_in_stream < len(text) else "?"
+        at = e.pos_in_stream or 0
+        char = text[at] if at < len(text) else "?"
         if char == '"':
             message, hint = "unterminated string", 'close the string with " on the same line'
         elif char == "'" or char == "~":
@@ -626,7 +641,7 @@ def _translate(e: UnexpectedInput, text: str, path: str) -> BgrSyntaxError:
             )
         else:
             message, hint = f"unexpected character {char!r}", None
-            if char == "-" and text[e.pos_in_stream : e.pos_in_stream + 2] == "->":
+            if char == "-" and text[at : at + 2] == "->":
                 hint = "a rule arrow is '-->'"
         return BgrSyntaxError(
             Diagnostic(path, line, column, message, hint, source_line(text, line))
@@ -698,7 +713,8 @@ def _deep_default(text: str, path: str) -> BgrSyntaxError | None:
                         line,
                         col,
                         "the defaults of this rule nest parentheses more than one level deep",
-                        "move the expression into a func (func f(x) = ...) and call that in the default",
+                        "move the expression into a func (func f(x) = ...) and call that in the "
+                        "default",
                         source_line(text, line),
                         i - j - 1,
                     )

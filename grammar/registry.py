@@ -92,14 +92,16 @@ OPERATIONS: dict[str, Op] = {
             "s",
             "transforms",
             _sig(Param("x", SIZE), Param("y", SIZE), Param("z", SIZE)),
-            "Set the scope size; the geometry is scaled with it. `'f` is relative to the current size.",
+            "Set the scope size; the geometry is scaled with it. `'f` is relative to the current "
+            "size.",
             "s('0.5, '1, 2)",
         ),
         Op(
             "center",
             "transforms",
             _sig(Param("axes", AXES)),
-            "Centre the scope along the given axes on the previous scope (the one saved by the last "
+            "Centre the scope along the given axes on the previous scope (the one saved by the "
+            "last "
             "`[`, or the shape the rule received).",
             "center(xz)",
         ),
@@ -142,7 +144,8 @@ OPERATIONS: dict[str, Op] = {
             "footprint",
             "components",
             _sig(Param("kind", FOOTPRINT_KIND), Param("a", NUMBER, 0.4), Param("b", NUMBER, -1.0)),
-            "Replace a 2D shape's outline by a building footprint filling its scope: `rect`, `L`, `U`, "
+            "Replace a 2D shape's outline by a building footprint filling its scope: `rect`, `L`, "
+            "`U`, "
             "`T`, `cross` (wing widths `a`, `b` as fractions of the scope; `b` defaults to `a`), "
             "`circle` (`a` sides, at least 3 when given).",
             "footprint(L, 0.4, 0.5)",
@@ -170,7 +173,8 @@ OPERATIONS: dict[str, Op] = {
                 Param("pitch", NUMBER, 30.0),
                 Param("overhang", NUMBER, 0.0),
             ),
-            "Build a roof of the given kind on a 2D footprint: pitch in degrees, overhang in metres.",
+            "Build a roof of the given kind on a 2D footprint: pitch in degrees, overhang in "
+            "metres.",
             "roof(hip, 30, 0.5)",
         ),
         # -- inserts -----------------------------------------------------------------------
@@ -178,7 +182,8 @@ OPERATIONS: dict[str, Op] = {
             "i",
             "inserts",
             _sig(Param("geometry", GEOMETRY)),
-            "Insert a primitive (cube, cylinder, sphere, quad, wedge) or a declared asset, fitted to "
+            "Insert a primitive (cube, cylinder, sphere, quad, wedge) or a declared asset, fitted "
+            "to "
             "the scope.",
             "i(cube)",
         ),
@@ -190,7 +195,8 @@ OPERATIONS: dict[str, Op] = {
                 (Param("color", COLOR),),
                 (Param("r", NUMBER), Param("g", NUMBER), Param("b", NUMBER)),
             ),
-            'Set the colour of the shape and its descendants: a "#rrggbb" string or r, g, b in 0..1.',
+            'Set the colour of the shape and its descendants: a "#rrggbb" string '
+            "or r, g, b in 0..1.",
             'color("#c8b89a")',
         ),
         Op(
@@ -260,7 +266,11 @@ BUILTIN_NAMES: dict[str, str] = {
     "split.total": "number of pieces of the enclosing split",
     "comp.index": "0-based index of the face in the enclosing component split",
     "comp.total": "number of faces of the enclosing component split",
-    "comp.left": "the corner at the face's left edge, seen from outside: the angle the wall turns there in degrees (90 at a box's corners, -90 at an inner corner, 0 where the wall runs on or for a top or bottom face)",
+    "comp.left": (
+        "the corner at the face's left edge, seen from outside: the angle the wall turns there in "
+        "degrees (90 at a box's corners, -90 at an inner corner, 0 where the wall runs on or for "
+        "a top or bottom face)"
+    ),
     "comp.right": "the corner at the face's right edge, as comp.left",
     "depth": "derivation depth of the shape",
     "seed": "the global seed",

@@ -66,12 +66,14 @@ def stdlib_markdown(example: dict[str, str] | None = None) -> str:
     out = [
         "# The standard library",
         "",
-        "Generated from the doc comments of `stdlib/*.bgr` by `python -m bgr.grammar.stdlib_reference`;",
+        "Generated from the doc comments of `stdlib/*.bgr` by `python -m "
+        "bgr.grammar.stdlib_reference`;",
         "thumbnails by `python docs/make_gallery.py`. Do not edit.",
         "",
         "The standard library is a set of `.bgr` modules bundled with bgr. A grammar imports them",
         "with `import stdlib.NAME as alias` and applies their rules like its own. Every rule takes",
-        "parameters with defaults ([defaults and keyword arguments](language.md#defaults-keyword-arguments-and-rules-as-parameters)),",
+        "parameters with defaults ([defaults and keyword "
+        "arguments](language.md#defaults-keyword-arguments-and-rules-as-parameters)),",
         "so `fac.Grid` and `fac.Grid(tile_w = 4, window = win.Arched)` both work, and the parts",
         "of a mass or a façade (its façades, windows, doors, roof) are rules handed over as",
         "parameters: plug in your own rule anywhere a stdlib part goes. The families follow",

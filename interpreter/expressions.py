@@ -311,7 +311,7 @@ class Compiler:
             body = holder.get(name)
             if body is None:
                 body = holder[name] = self.expr(func.body, frozenset(params))
-            bound = {p: a(ctx) for p, a in zip(params, args)}
+            bound = {p: a(ctx) for p, a in zip(params, args, strict=False)}
             saved = ctx.args
             ctx.args = bound
             try:

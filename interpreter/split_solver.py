@@ -16,7 +16,7 @@ from __future__ import annotations
 import itertools
 import math
 from dataclasses import dataclass, field
-from typing import Any, Union
+from typing import Any
 
 EPS = 1e-9
 MAX_GROUPS_EXACT = 8  # up to 2**8 extra-repetition patterns are searched exhaustively
@@ -34,7 +34,7 @@ class Repeat:
     items: tuple[Item, ...]
 
 
-Item = Union[Piece, Repeat]
+Item = Piece | Repeat
 
 
 @dataclass(frozen=True)
@@ -158,12 +158,12 @@ def _repetitions(groups: list[Repeat], avail: float, float_out: float, length: f
     )
     best = None
     for extra in patterns:
-        extra_len = sum(e * (a + f) for e, (a, f) in zip(extra, nominal))
+        extra_len = sum(e * (a + f) for e, (a, f) in zip(extra, nominal, strict=True))
         k_star = (avail - float_out - extra_len) / per_rep
         for k in {max(1, math.floor(k_star)), max(1, math.ceil(k_star))}:
             counts = [k + e for e in extra]
-            fixed = sum(c * a for c, (a, _) in zip(counts, nominal))
-            flo = float_out + sum(c * f for c, (_, f) in zip(counts, nominal))
+            fixed = sum(c * a for c, (a, _) in zip(counts, nominal, strict=True))
+            flo = float_out + sum(c * f for c, (_, f) in zip(counts, nominal, strict=True))
             if flo <= 0:
                 continue
             s = (avail - fixed) / flo
@@ -175,7 +175,7 @@ def _repetitions(groups: list[Repeat], avail: float, float_out: float, length: f
     if best is None:  # the absolute parts of one repetition alone overflow: one, cut later
         return {id(g): 1 for g in groups}, 0.0
     _, counts, s = best
-    return {id(g): c for g, c in zip(groups, counts)}, s
+    return {id(g): c for g, c in zip(groups, counts, strict=True)}, s
 
 
 def _fill_remainder(sized, groups, avail, length):

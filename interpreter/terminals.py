@@ -10,6 +10,7 @@ transform them in bulk (``world = origin + (v * size) @ axes``) or instance them
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 
@@ -51,16 +52,19 @@ class TerminalTable:
     label: list[str] = field(default_factory=list)
     rule: list[str] = field(default_factory=list)
     path: list[str] = field(default_factory=list)
-    origin: list = field(default_factory=list)  # frozen: (N, 3)
-    axes: list = field(default_factory=list)  # frozen: (N, 3, 3), rows are the unit x, y, z axes
-    size: list = field(default_factory=list)  # frozen: (N, 3)
-    color: list = field(default_factory=list)  # frozen: (N, 3) in 0..1
-    material: list = field(default_factory=list)  # str or None
-    mesh: list = field(default_factory=list)  # frozen: (N,) int32 ids into library
-    library: MeshLibrary = field(default_factory=MeshLibrary)
-    lots: list = field(
+    origin: Any = field(default_factory=list)  # a list while deriving; frozen: (N, 3)
+    axes: Any = field(
         default_factory=list
-    )  # per lot: {"path", "origin", "axes", "size"} (its frame)
+    )  # a list while deriving; frozen: (N, 3, 3), rows are the unit x, y, z axes
+    size: Any = field(default_factory=list)  # a list while deriving; frozen: (N, 3)
+    color: Any = field(default_factory=list)  # a list while deriving; frozen: (N, 3) in 0..1
+    material: list = field(default_factory=list)  # str or None
+    mesh: Any = field(
+        default_factory=list
+    )  # a list while deriving; frozen: (N,) int32 ids into library
+    library: MeshLibrary = field(default_factory=MeshLibrary)
+    # per lot: {"path", "origin", "axes", "size"} (its frame)
+    lots: list = field(default_factory=list)
     frozen: bool = False
 
     def __len__(self) -> int:

@@ -175,7 +175,7 @@ def render_labels(
     attrs: dict | None = None,
     lot: Any = None,
 ) -> tuple[np.ndarray, dict]:
-    """The ``labels`` image and its legend ``{"background": "#000000", "labels": {label: colour}}``."""
+    """The ``labels`` image and its legend ``{"background": "#000000", "labels": {label: rgb}}``."""
     image, legend = _render(source, "labels", view, size, backend, seed, attrs, lot)
     assert legend is not None
     return image, legend

@@ -99,7 +99,8 @@ class Camera:
             or np.linalg.det(self.rotation) < 0
         ):
             raise BgrError(
-                "the camera rotation must be a proper rotation matrix (orthonormal rows, determinant +1)"
+                "the camera rotation must be a proper rotation matrix (orthonormal rows, "
+                "determinant +1)"
             )
 
     # --- constructors -----------------------------------------------------------------------
@@ -167,7 +168,7 @@ class Camera:
 
     @classmethod
     def preset(cls, name: str, lo, hi, size=(1024, 768)) -> Camera:
-        """View ``front``, ``iso`` or ``top`` placed so that the box ``lo``..``hi`` fills the frame."""
+        """View ``front``, ``iso`` or ``top``, placed so the box ``lo``..``hi`` fills the frame."""
         if name not in PRESETS:
             raise BgrError(
                 f"unknown view '{name}'; known views: {', '.join(PRESETS)}, or a camera .json file"
@@ -365,7 +366,8 @@ def _from_dict(cls, data: Any, shown: str, size) -> Camera:
             sz = vector("size", 2)
             if not all(v >= 1 and float(v).is_integer() for v in sz):
                 raise bad(
-                    f"camera key 'size' must be two positive whole numbers, got {json.dumps(data['size'])}"
+                    "camera key 'size' must be two positive whole numbers, got "
+                    f"{json.dumps(data['size'])}"
                 )
             size = (int(sz[0]), int(sz[1]))
     angles = [k for k in ("yaw", "pitch", "roll") if k in data]

@@ -93,8 +93,9 @@ def lines(frame: Frame, scene: Scene, width: int = 1) -> np.ndarray:
 
     An edge lies between two neighbouring pixels that show different faces (:func:`face_ids`),
     or the model and the background: a change of label or colour, of plane (a crease: a change
-    of normal; a step: a change of depth) or the outline.  It is drawn on the nearer of the two pixels, so
-    lines are one pixel wide and sit on the surface in front; ``width`` > 1 thickens them.
+    of normal; a step: a change of depth) or the outline.  It is drawn on the nearer of the two
+    pixels, so lines are one pixel wide and sit on the surface in front; ``width`` > 1 thickens
+    them.
     """
     fid = np.concatenate([face_ids(scene), [-1]])[frame.triangle]
     depth = frame.depth

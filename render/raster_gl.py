@@ -57,7 +57,7 @@ _state: dict[str, Any] = {}
 
 
 def _context() -> Any:
-    """The process's moderngl context and program, made on first use; GLUnavailable if it cannot be."""
+    """The process's moderngl context and program, made on first use (GLUnavailable if it can't)."""
     with _lock:
         if "error" in _state:
             raise GLUnavailable(_state["error"])

@@ -10,6 +10,7 @@
 
 from __future__ import annotations
 
+import contextlib
 import copy
 import json
 import math
@@ -18,6 +19,10 @@ from pathlib import Path
 
 import jsonschema
 import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+
+from bgr import BgrError
 from bgr.inverse.schema.captured import (
     SCHEMA,
     load_captured,
@@ -26,10 +31,6 @@ from bgr.inverse.schema.captured import (
     schema_text,
 )
 from bgr.inverse.schema.model import Model, default_fixed
-from hypothesis import HealthCheck, given, settings
-from hypothesis import strategies as st
-
-from bgr import BgrError
 
 ROOT = Path(__file__).resolve().parent.parent
 EXAMPLE = ROOT / "examples" / "captured" / "corner_shop.json"
@@ -50,7 +51,7 @@ def json_leaves(sub: dict, occluded: bool = False) -> list[tuple[str, bool]]:
 
 
 def close(a, b, tol=1e-9) -> bool:
-    return all(abs(x - y) <= tol for x, y in zip(a, b))
+    return all(abs(x - y) <= tol for x, y in zip(a, b, strict=True))
 
 
 # ---- 1. the example ------------------------------------------------------------------------------
@@ -261,7 +262,7 @@ def test_cylinder_facets():
     assert all((f.left, f.right) == ("outer", "outer") for f in faces)
     assert faces[0].root.leaves()[0].label == "door" and faces[0].root.leaves()[0].fixed
     for f, g in zip(
-        faces, faces[1:] + faces[:1]
+        faces, faces[1:] + faces[:1], strict=True
     ):  # each facet's right end is the next one's left end
         assert close([f.origin[i] + f.width * f.x_axis[i] for i in range(3)], g.origin)
 
@@ -312,7 +313,7 @@ def test_prism_rectangle_is_a_box(footprint):
     assert all((f.left, f.right) == ("outer", "outer") for f in faces)
     front = next(f for f in faces if f.side == "front")
     assert (front.origin, front.x_axis, front.width) == ((6.0, 0.0, 0.0), (-1.0, 0.0, 0.0), 6.0)
-    for f, g in zip(faces, faces[1:] + faces[:1]):
+    for f, g in zip(faces, faces[1:] + faces[:1], strict=True):
         assert close([f.origin[i] + f.width * f.x_axis[i] for i in range(3)], g.origin)
 
 
@@ -902,10 +903,9 @@ def _apply(data, path, action, new):
 def test_fuzz_mutated_example(mutations):
     data = copy.deepcopy(EXAMPLE_DATA)
     for path, action, new in mutations:
-        try:
+        # an earlier mutation may have removed or retyped this path
+        with contextlib.suppress(KeyError, IndexError, TypeError):
             _apply(data, path, action, new)
-        except (KeyError, IndexError, TypeError):
-            pass  # an earlier mutation removed or retyped this path
     only_bgr_errors(data)
 
 

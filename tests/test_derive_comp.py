@@ -5,11 +5,13 @@ import json
 
 import numpy as np
 import pytest
-from bgr.interpreter.writers import write_json
 
 import bgr
+from bgr.interpreter.writers import write_json
 
-BOX = """Lot --> extrude(4) comp(f) { front: F | back: B | left: L | right: R | top: T | bottom: Bo }
+BOX = """Lot --> extrude(4) comp(f) {
+    front: F | back: B | left: L | right: R | top: T | bottom: Bo
+}
 terminal F, B, L, R, T, Bo
 """
 
@@ -92,7 +94,8 @@ def test_faces_of_an_l_shaped_footprint(tmp_path):
 def test_comp_left_and_right_name_the_corners_of_each_side_face():
     """comp.left/comp.right: 90 at an outer corner, -90 at an inner one, seen from outside."""
     src = (
-        "Lot --> footprint(L, 0.4, 0.5) extrude(5) comp(f) { side: F(comp.left, comp.right) | all: NIL }\n"
+        "Lot --> footprint(L, 0.4, 0.5) extrude(5) comp(f) { side: F(comp.left, comp.right) | all: "
+        "NIL }\n"
         'F(l, r) --> label(l == 90 ? (r == 90 ? "oo" : "oi") : (r == 90 ? "io" : "ii")) X\n'
         "terminal X\n"
     )

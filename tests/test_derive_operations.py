@@ -5,9 +5,9 @@ import json
 import numpy as np
 import pytest
 import trimesh
-from bgr.interpreter.terminals import world_vertices
 
 import bgr
+from bgr.interpreter.terminals import world_vertices
 
 
 def table(src, **kw):

@@ -7,10 +7,10 @@ import math
 
 import numpy as np
 import pytest
-from bgr.interpreter.terminals import world_vertices
 from shapely.geometry import LineString, Point, Polygon
 
 import bgr
+from bgr.interpreter.terminals import world_vertices
 
 FOOTPRINTS = {
     "rect": [(0, 0), (16, 0), (16, 10), (0, 10)],
@@ -38,7 +38,10 @@ def roof_triangles(tmp_path, name, kind):
             }
         )
     )
-    src = f"Lot --> extrude({HEIGHT}) comp(f) {{ top: roof({kind}, {PITCH}) Roof | side: Wall }}\nterminal Roof, Wall\n"
+    src = (
+        f"Lot --> extrude({HEIGHT}) comp(f) {{ top: roof({kind}, {PITCH}) Roof | side: Wall }}\n"
+        "terminal Roof, Wall\n"
+    )
     t = bgr.derive(bgr.load(src), lot=str(geo)).terminals
     rows = [i for i, lab in enumerate(t.label) if lab == "Roof"]
     assert len(rows) == 1
@@ -119,6 +122,7 @@ def test_roof_eaves_are_the_wall_tops(tmp_path, name, kind):
 )
 def test_closed_form_rectangle_hip_matches_the_straight_skeleton(w, d, overhang):
     import trimesh
+
     from bgr.interpreter.geometry.rect_roofs import rectangle_hip
     from bgr.interpreter.geometry.roofs import roof_mesh
 

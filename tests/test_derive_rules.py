@@ -43,11 +43,11 @@ def test_editing_one_subtree_keeps_the_draws_of_the_others():
     )
     a = bgr.derive(bgr.load(before), seed=11).terminals
     b = bgr.derive(bgr.load(after), seed=11).terminals
-    ya = [s[1] for s, lab in zip(a.size, a.label) if lab == "Y"]
-    yb = [s[1] for s, lab in zip(b.size, b.label) if lab == "Y"]
+    ya = [s[1] for s, lab in zip(a.size, a.label, strict=True) if lab == "Y"]
+    yb = [s[1] for s, lab in zip(b.size, b.label, strict=True) if lab == "Y"]
     assert ya == yb and len(ya) == 10
-    xa = [s[1] for s, lab in zip(a.size, a.label) if lab == "X"]
-    xb = [s[1] for s, lab in zip(b.size, b.label) if lab == "X"]
+    xa = [s[1] for s, lab in zip(a.size, a.label, strict=True) if lab == "X"]
+    xb = [s[1] for s, lab in zip(b.size, b.label, strict=True) if lab == "X"]
     assert xa != xb
 
 

@@ -4,10 +4,10 @@ import io
 import json
 
 import pytest
-from bgr.interpreter.split_solver import Piece, Repeat, solve
-from bgr.interpreter.writers import write_json
 
 import bgr
+from bgr.interpreter.split_solver import Piece, Repeat, solve
+from bgr.interpreter.writers import write_json
 
 
 def pieces(block: str, length: float = 10.0):
@@ -64,7 +64,8 @@ def test_contract_examples(block, length, expected):
 
 def test_split_index_and_total_are_global_across_repetitions():
     src = (
-        "Lot --> split(x) { '0.1: A(split.index, split.total) | '0.1: A(split.index, split.total) }*\n"
+        "Lot --> split(x) { '0.1: A(split.index, split.total) | '0.1: A(split.index, split.total) "
+        "}*\n"
         "A(i, n) --> s(i + 1, n, 1)\n"
     )
     t = bgr.derive(bgr.load(src), lot=(10, 5)).terminals
@@ -75,7 +76,8 @@ def test_split_index_and_total_are_global_across_repetitions():
 def test_pieces_tile_the_scope_in_order():
     t = bgr.derive(
         bgr.load(
-            'Lot --> split(z) { 2: A | ~1: B | 3: C }\nA --> NIL B\nB --> color("#000000")\nC --> B\n'
+            "Lot --> split(z) { 2: A | ~1: B | 3: C }\n"
+            'A --> NIL B\nB --> color("#000000")\nC --> B\n'
         ),
         lot=(4, 10),
     ).terminals

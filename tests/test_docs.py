@@ -8,6 +8,8 @@ import re
 from pathlib import Path
 
 import pytest
+
+import bgr
 from bgr.grammar.reference import reference_markdown
 from bgr.grammar.registry import (
     BUILTIN_NAMES,
@@ -18,8 +20,6 @@ from bgr.grammar.registry import (
     PRIMITIVES,
     ROOF_KINDS,
 )
-
-import bgr
 
 ROOT = Path(__file__).resolve().parent.parent
 DOCS = ROOT / "docs"

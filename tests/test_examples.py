@@ -5,8 +5,9 @@ import subprocess
 import sys
 
 import pytest
-from bgr.interpreter.writers import read_glb
 from conftest import ROOT
+
+from bgr.interpreter.writers import read_glb
 
 EXAMPLES = [
     ("house.bgr", []),

@@ -6,6 +6,9 @@ from __future__ import annotations
 import itertools
 
 import pytest
+from hypothesis import assume, given, settings
+from hypothesis import strategies as st
+
 from bgr.interpreter.split_solver import Piece, Repeat, solve
 from bgr.inverse.schema.faces import (
     Star,
@@ -19,8 +22,6 @@ from bgr.inverse.schema.faces import (
     to_text,
     unroll,
 )
-from hypothesis import assume, given, settings
-from hypothesis import strategies as st
 
 # ---- the symbolic rule ---------------------------------------------------------------------------
 
@@ -85,7 +86,9 @@ def test_rewrite_never_stars_aa_nor_adjacent_equal_stars(face):
 
 @given(faces)
 def test_rewrite_marks_exactly_the_reoccurring_pairs(face):
-    occurs = lambda a, b: sum(face[i] == a and face[i + 1] == b for i in range(len(face) - 1))
+    def occurs(a, b):
+        return sum(face[i] == a and face[i + 1] == b for i in range(len(face) - 1))
+
     items = rewrite(face)
     for s in stars(items):
         assert occurs(face[s.first_index], face[s.second_index]) >= 2
@@ -132,7 +135,10 @@ def test_counts_expressible():
 
 def via_solver(items, widths, fixed, length):
     """The equivalent split solved by LANGUAGE.md section 6: (counts per star, scale)."""
-    kind = lambda c: "abs" if fixed[c] else "float"
+
+    def kind(c):
+        return "abs" if fixed[c] else "float"
+
     split, groups = [], stars(items)
     for item in items:
         if isinstance(item, Sym):
@@ -149,15 +155,18 @@ def via_solver(items, widths, fixed, length):
             )
     placed = solve(split, length)
     counts = tuple(sum(p.payload == ("star", g, 0) for p in placed) for g in range(len(groups)))
-    column = lambda p: (
-        p.payload[1]
-        if p.payload[0] == "sym"
-        else (
-            groups[p.payload[1]].first_index
-            if p.payload[2] == 0
-            else groups[p.payload[1]].second_index
+
+    def column(p):
+        return (
+            p.payload[1]
+            if p.payload[0] == "sym"
+            else (
+                groups[p.payload[1]].first_index
+                if p.payload[2] == 0
+                else groups[p.payload[1]].second_index
+            )
         )
-    )
+
     scales = [p.size / widths[column(p)] for p in placed if not fixed[column(p)]]
     assert not scales or max(scales) - min(scales) < 1e-9
     return counts, scales[0] if scales else 0.0  # pieces of no size are not placed
@@ -240,7 +249,8 @@ def test_retarget_grows_symmetrically():
 def test_ties_go_to_more_repetitions():
     items = rewrite(list("ABABC"))  # (AB)*C, all stretch, widths 1: 1 rep s = 4/3, 2 reps s = 4/5
     widths, fixed = [1.0] * 5, [False] * 5
-    # at 4 the two are 1/3 and 1/5 off; find the length where both are equally far: L/3 - 1 = 1 - L/5
+    # at 4 the two are 1/3 and 1/5 off; find the length where both are equally far: L/3 - 1 = 1 -
+    # L/5
     length = 2 / (1 / 3 + 1 / 5)
     assert retarget(items, widths, fixed, length)[0] == (2,)
     assert via_solver(items, widths, fixed, length)[0] == (2,)

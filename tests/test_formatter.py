@@ -1,10 +1,10 @@
 """The formatter: canonical layout, comments kept, idempotent, meaning unchanged."""
 
 import pytest
-from bgr.grammar import nodes as n
 from conftest import SHARED, shipped_grammars
 
 from bgr import format_module, format_source, parse
+from bgr.grammar import nodes as n
 
 
 @pytest.mark.parametrize("path", shipped_grammars(), ids=lambda p: p.name)
@@ -24,7 +24,10 @@ def test_round_trip_and_idempotence_on_real_grammars(path):
 
 
 def test_spacing_is_canonical():
-    ugly = "attr   a=1+2*  3\nA-->extrude( a )split(x){3:B|~1 :C}*   [t(0,0,1)B]\nB-->60 % : C|else:NIL\nC-->NIL"
+    ugly = (
+        "attr   a=1+2*  3\nA-->extrude( a )split(x){3:B|~1 :C}*   [t(0,0,1)B]\n"
+        "B-->60 % : C|else:NIL\nC-->NIL"
+    )
     assert format_source(ugly) == (
         "attr a = 1 + 2 * 3\n"
         "A --> extrude(a) split(x) { 3: B | ~1: C }* [ t(0, 0, 1) B ]\n"
@@ -64,7 +67,10 @@ def test_comments_stay_where_they_belong():
 
 
 def test_long_rules_break_into_one_entry_per_line():
-    rule = "Floor --> split(x) { 0.5: WallPieceLeft | { ~3: TileWithWindowAndBalcony }* | 0.5: WallPieceRight | 0.25: Pilaster }"
+    rule = (
+        "Floor --> split(x) { 0.5: WallPieceLeft | { ~3: TileWithWindowAndBalcony }* "
+        "| 0.5: WallPieceRight | 0.25: Pilaster }"
+    )
     assert format_source(rule) == (
         "Floor --> split(x) {\n"
         "    0.5: WallPieceLeft\n"
@@ -73,7 +79,10 @@ def test_long_rules_break_into_one_entry_per_line():
         "    | 0.25: Pilaster\n"
         "}\n"
     )
-    choice = "Window --> 40%: ArchedWindowWithShutters | 30%: PlainWindowWithSill | 20%: BalconyDoorWindow | else: NIL"
+    choice = (
+        "Window --> 40%: ArchedWindowWithShutters | 30%: PlainWindowWithSill "
+        "| 20%: BalconyDoorWindow | else: NIL"
+    )
     assert format_source(choice) == (
         "Window -->\n"
         "    40%: ArchedWindowWithShutters\n"

@@ -19,6 +19,7 @@ tests at the end of the file (a fix turns them into failures, so the marks get r
 
 from __future__ import annotations
 
+import contextlib
 import os
 import random
 import re
@@ -27,6 +28,13 @@ import sys
 from pathlib import Path
 
 import pytest
+from hypothesis import HealthCheck, given, note, settings
+from hypothesis import strategies as st
+from hypothesis.errors import InvalidArgument
+
+import bgr
+from bgr import BgrError
+from bgr.cli import main
 from bgr.grammar import nodes as n
 from bgr.grammar.formatter import format_module, format_source
 from bgr.grammar.parser import parse
@@ -41,13 +49,6 @@ from bgr.grammar.registry import (
     PRIMITIVES,
     ROOF_KINDS,
 )
-from hypothesis import HealthCheck, given, note, settings
-from hypothesis import strategies as st
-from hypothesis.errors import InvalidArgument
-
-import bgr
-from bgr import BgrError
-from bgr.cli import main
 
 ROOT = Path(__file__).resolve().parent.parent
 BENCH = Path(os.environ.get("BGR_BENCH_GRAMMAR", "/work/shared/bench/grid_city.bgr"))
@@ -282,7 +283,7 @@ def test_random_token_sequences_raise_only_bgr_errors(text):
     load_only_bgr_errors(as_text(text), path=str(ROOT / "examples" / "fuzz.bgr"))
 
 
-# ---- generated valid grammars ----------------------------------------------------------------------
+# ---- generated valid grammars --------------------------------------------------------------------
 
 _CMP = {"==", "!=", "<", "<=", ">", ">="}
 _BINARY = ["+", "-", "*", "/", "%", "**", "==", "!=", "<", "<=", ">", ">=", "and", "or"]
@@ -586,7 +587,10 @@ class _Gen:
         given = required + self.d(st.integers(0, count - required))
         args = [self.num(ctx["names"], ctx["funcs"], depth=1) for _ in range(given)]
         if given > required and self.chance(0.5):  # the optional ones by name, in any order
-            optional = [[f"p{j}", "="] + a for j, a in zip(range(required, given), args[required:])]
+            optional = [
+                [f"p{j}", "="] + a
+                for j, a in zip(range(required, given), args[required:], strict=True)
+            ]
             args = args[:required] + self.rng_shuffled(optional)
         if not args:
             return [name] + (["(", ")"] if self.chance(0.3) else [])
@@ -817,7 +821,7 @@ def valid_grammars(draw, comments: bool = True):
     return text, g.comments
 
 
-# ---- 3. mutations ---------------------------------------------------------------------------------
+# ---- 3. mutations --------------------------------------------------------------------------------
 
 _TOKEN_RE = re.compile(
     r'"(?:\\.|[^"\\\n])*"|#[^\n]*|//[^\n]*|-->|\*\*|==|!=|<=|>=|[A-Za-z_][A-Za-z0-9_.]*'
@@ -834,10 +838,7 @@ _INSERTS = st.one_of(
 @st.composite
 def mutated(draw, source: str) -> str:
     """`source` with 1 to 6 random edits, on characters or on tokens."""
-    if draw(st.booleans()):
-        units = _TOKEN_RE.findall(source)
-    else:
-        units = list(source)
+    units = _TOKEN_RE.findall(source) if draw(st.booleans()) else list(source)
     for _ in range(draw(st.integers(1, 6))):
         size = len(units)
         kind = draw(st.sampled_from(["delete", "duplicate", "swap", "insert", "replace"]))
@@ -869,10 +870,8 @@ def test_mutated_shipped_grammars_raise_only_bgr_errors(data):
     text = data.draw(mutated(SHIPPED_TEXT[path]), label="mutated text")
     # the real path, so that city_block.bgr's `import "house.bgr"` resolves beside it
     load_only_bgr_errors(text, path=str(path))
-    try:
+    with contextlib.suppress(BgrError):
         format_source(text)
-    except BgrError:
-        pass
 
 
 @fuzz_settings(200)
@@ -881,10 +880,8 @@ def test_mutated_generated_grammars_raise_only_bgr_errors(data):
     text, _ = data.draw(valid_grammars(), label="grammar")
     text = data.draw(mutated(text), label="mutated text")
     load_only_bgr_errors(as_text(text))
-    try:
+    with contextlib.suppress(BgrError):
         format_source(text)
-    except BgrError:
-        pass
 
 
 # ---- 4. the CLI ---------------------------------------------------------------------------------
@@ -970,7 +967,7 @@ def test_cli_subprocess_shipped_grammar_formats_and_checks():
     assert proc.returncode == 0
 
 
-# ---- 5. the formatter round trip ------------------------------------------------------------------
+# ---- 5. the formatter round trip -----------------------------------------------------------------
 
 _COMMENT_RE = re.compile(r'"(?:\\.|[^"\\\n])*"|(#[^\n]*|//[^\n]*)')
 
@@ -980,10 +977,9 @@ def _comments_of(text: str) -> list[str]:
 
 
 def _note(message: str) -> None:
-    try:
+    # outside a hypothesis test note() refuses: the assertion message says enough there
+    with contextlib.suppress(InvalidArgument):
         note(message)
-    except InvalidArgument:  # outside a hypothesis test: the assertion message says enough
-        pass
 
 
 def assert_round_trip(text: str, comments: list[str] | None = None) -> str:
@@ -1123,7 +1119,7 @@ def test_expression_trees_in_rule_positions(a, b):
     assert format_source(text) == text
 
 
-# ---- defects found by the fuzzing: smallest reproductions, strict xfail ----------------------------
+# ---- defects found by the fuzzing: smallest reproductions, strict xfail --------------------------
 # Each test states the behaviour the contract asks for.  They fail today; when a fix lands, the
 # strict xfail turns into a failure, and the mark must go.
 
@@ -1227,10 +1223,8 @@ def test_bug6_fmt_deep_nesting_is_not_an_internal_error(name, tmp_path, capsys, 
 
 @pytest.mark.parametrize("name", ["power-chain", "prefix-minus"])
 def test_bug6_parse_deep_nesting_raises_bgr_error(name):
-    try:
+    with contextlib.suppress(BgrError):
         format_source(_DEEP[name])
-    except BgrError:
-        pass
 
 
 def test_deep_nesting_check_is_clean(tmp_path, capsys, monkeypatch):
@@ -1254,7 +1248,8 @@ def test_bug7_format_module_nul_in_string():
     assert parse(text) == module
 
 
-# Bug 8: RULE_NAME's look-ahead `(\s|#[^\n]*|\/\/[^\n]*)*(\([^()]*\))?(\s|#[^\n]*|...)*-->` can split
+# Bug 8: RULE_NAME's look-ahead `(\s|#[^\n]*|\/\/[^\n]*)*(\([^()]*\))?(\s|#[^\n]*|...)*-->` can
+# split
 # a run of '#' (or '/') characters into comments in exponentially many ways, and tries them all
 # whenever a successor that ends a rule body is followed by such comments without a `-->`.
 # 24 '#' take ~15 s, each more doubles it; a banner such as "############" above and below a
@@ -1273,7 +1268,8 @@ def test_bug8_banner_comment_does_not_hang(tmp_path):
 
 
 def test_bug8_formatted_commented_rule_parses_fast(tmp_path):
-    # the source parses in a blink; its canonical form "A --> B C C ... C  # 1  # 2 ... # 20" does not
+    # the source parses in a blink; its canonical form "A --> B C C ... C  # 1  # 2 ... # 20" does
+    # not
     source = "A --> B C # 1\n" + "".join(f"  C # {i}\n" for i in range(2, 21)) + "terminal B, C\n"
     path = tmp_path / "commented.bgr"
     path.write_text(source, encoding="utf-8")

@@ -3,11 +3,11 @@
 
 import numpy as np
 import pytest
-from bgr.interpreter.terminals import color_hex
 from errors_helpers import check
 
 import bgr
 from bgr import format_source
+from bgr.interpreter.terminals import color_hex
 
 
 def derive(src, **kw):
@@ -200,7 +200,7 @@ def test_a_held_rule_the_arguments_do_not_fit_is_a_runtime_error():
 
 
 def test_a_parameter_named_like_an_operation_applies_its_rule_with_keywords():
-    """`roof(pitch = 30)` with a parameter `roof` is the held rule; `roof(hip, 30)` the operation."""
+    """`roof(pitch = 30)` with a parameter `roof` is the held rule, `roof(hip, 30)` the op."""
     src = (
         "Lot(roof = Gable) --> extrude(5) comp(f) { top: roof(pitch = 30) | all: NIL }\n"
         "Gable(pitch = 10) --> s(1, pitch, 1) X\nterminal X\n"
@@ -243,7 +243,8 @@ def test_footprint_areas_and_volumes(kind, args, area):
 
 def test_footprint_front_face_is_on_the_lot_front_edge():
     src = (
-        "Lot --> footprint(L, 0.3, 0.4) extrude(5) comp(f) { front: F | side: S | top: NIL | bottom: NIL }\n"
+        "Lot --> footprint(L, 0.3, 0.4) extrude(5) comp(f) { front: F | side: S | top: NIL | "
+        "bottom: NIL }\n"
         "terminal F, S\n"
     )
     t = derive(src, lot=(20, 10))

@@ -1,10 +1,10 @@
 """The parser builds the syntax tree the language reference describes."""
 
 import pytest
-from bgr.grammar import nodes as n
-from bgr.grammar.parser import parse
 
 import bgr
+from bgr.grammar import nodes as n
+from bgr.grammar.parser import parse
 
 
 def body(src: str):

@@ -10,6 +10,11 @@ import numpy as np
 import pytest
 import shapely
 import trimesh
+from conftest import ROOT
+from PIL import Image
+
+import bgr
+from bgr.cli import main
 from bgr.render import (
     Camera,
     images,
@@ -22,11 +27,6 @@ from bgr.render import (
     save_png,
 )
 from bgr.render.scene import Scene, from_trimesh
-from conftest import ROOT
-from PIL import Image
-
-import bgr
-from bgr.cli import main
 
 HOUSE = ROOT / "examples" / "house.bgr"
 
@@ -325,7 +325,7 @@ def test_auto_falls_back_to_numpy_once_gl_fails(house, monkeypatch):
 
 
 def test_forked_child_falls_back_instead_of_hanging():
-    """Mesa hangs a forked child that makes a context after its parent did: the child must not try."""
+    """Mesa hangs a forked child making a context after its parent did: the child must not try."""
     gl_or_skip()
     code = (
         "import os\n"

@@ -15,6 +15,8 @@ from collections import Counter
 import numpy as np
 import pytest
 import shapely
+from shapely.geometry import LineString, Polygon
+
 from bgr.interpreter.geometry.earclip import triangulate
 from bgr.interpreter.geometry.roofs import (
     KINDS,
@@ -24,7 +26,6 @@ from bgr.interpreter.geometry.roofs import (
     roof_mesh,
 )
 from bgr.interpreter.geometry.skeleton import offset_outward, straight_skeleton
-from shapely.geometry import LineString, Polygon
 
 trimesh = pytest.importorskip("trimesh")
 
@@ -81,7 +82,7 @@ class TestSkeletonRoofs:
     def test_vertices_lie_on_their_edge_planes(self, name, kind):
         poly = footprint(name)
         mesh = roof_mesh(poly, kind, PITCH)
-        for face, p in zip(mesh.faces, mesh.face_plane):
+        for face, p in zip(mesh.faces, mesh.face_plane, strict=True):
             plane = mesh.planes[p]
             a, n = edge_frame(poly, plane.edge)
             dist = (mesh.vertices[face, :2] - a) @ n
@@ -183,7 +184,7 @@ def test_overhang_keeps_the_planes(name, kind):
         if p.kind == "wall":  # a shed's walls follow the eave
             continue
         assert p.offset == pytest.approx(planes[key(p)], abs=TOL)
-    for face, p in zip(mesh.faces, mesh.face_plane):
+    for face, p in zip(mesh.faces, mesh.face_plane, strict=True):
         plane = mesh.planes[p]
         assert np.allclose(mesh.vertices[face] @ plane.normal, plane.offset, atol=TOL)
     solid = capped(mesh)
@@ -305,7 +306,7 @@ def test_every_kind_is_finite_and_consistent(name, kind, overhang):
     tri = mesh.vertices[mesh.faces]
     doubled_areas = np.linalg.norm(np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]), axis=1)
     assert (doubled_areas > 1e-9).all()
-    for face, p in zip(mesh.faces, mesh.face_plane):
+    for face, p in zip(mesh.faces, mesh.face_plane, strict=True):
         plane = mesh.planes[p]
         assert np.allclose(mesh.vertices[face] @ plane.normal, plane.offset, atol=TOL)
     if kind != "flat":
@@ -413,7 +414,9 @@ def test_skeleton_of_random_rectilinear_and_star_shapes():
         else:
             corners = rng.integers(0, 8, (int(rng.integers(2, 6)), 2))
             sizes = rng.integers(1, 5, corners.shape)
-            shape = shapely.union_all([shapely.box(*c, *(c + s)) for c, s in zip(corners, sizes)])
+            shape = shapely.union_all(
+                [shapely.box(*c, *(c + s)) for c, s in zip(corners, sizes, strict=True)]
+            )
         if shape.geom_type != "Polygon" or shape.interiors or not shape.is_valid:
             continue
         shape = shapely.geometry.polygon.orient(shapely.simplify(shape, 0), 1.0)

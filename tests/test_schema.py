@@ -13,15 +13,15 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from bgr.interpreter.writers import write_json
-from bgr.inverse.schema import faces as fs
-from bgr.inverse.schema import infer, read_model
 from conftest import ROOT
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 import bgr
 from bgr.cli import main
+from bgr.interpreter.writers import write_json
+from bgr.inverse.schema import faces as fs
+from bgr.inverse.schema import infer, read_model
 
 DATA = ROOT / "tests" / "data" / "schema"
 SOURCES = sorted(DATA.glob("*.bgr"))
@@ -122,7 +122,9 @@ PAIRS = """\
 attr W = 8.4
 terminal Wall, Window, Pier
 Lot --> s(W, 0, 10) extrude(6) comp(f) { front: Front | side: Pier | top: NIL | bottom: NIL }
-Front --> split(x) { ~1: Wall | ~1: Wall | 1.2: Window | ~1: Wall | ~1: Wall | 1.2: Window | ~1: Wall | ~1: Wall }
+Front --> split(x) {
+    ~1: Wall | ~1: Wall | 1.2: Window | ~1: Wall | ~1: Wall | 1.2: Window | ~1: Wall | ~1: Wall
+}
 """
 
 
@@ -156,11 +158,13 @@ def test_retargeting_follows_the_papers_application_rule(src, pattern, factor):
     front = [t for t in target if "FrontFacade" in t["path"]]
     assert sum(t["label"] == "Window" for t in front) == sum(
         c
-        for c, st in zip(counts, fs.stars(items))
+        for c, st in zip(counts, fs.stars(items), strict=True)
         if "Window" in (columns[st.first_index].label, columns[st.second_index].label)
     ) + sum(1 for it in items if isinstance(it, fs.Sym) and columns[it.index].label == "Window")
     stretched = [
-        (t["size"][0], c) for t, c in zip(front, _expanded(items, counts, columns)) if not c.fixed
+        (t["size"][0], c)
+        for t, c in zip(front, _expanded(items, counts, columns), strict=True)
+        if not c.fixed
     ]
     for got, column in stretched:
         assert got == pytest.approx(column.size * scale, abs=1e-6)
@@ -198,7 +202,8 @@ def test_a_box_schema_styles_every_face_of_an_l_and_a_u(ring, tmp_path):
     faces = by_face(out)
     vertical = {k: v for k, v in faces.items() if abs(k[0][1]) < 0.5}
     planes = {
-        (a[0] == b[0], a[0] if a[0] == b[0] else a[1]) for a, b in zip(ring, ring[1:] + ring[:1])
+        (a[0] == b[0], a[0] if a[0] == b[0] else a[1])
+        for a, b in zip(ring, ring[1:] + ring[:1], strict=True)
     }
     assert len(vertical) == len(
         planes
@@ -295,7 +300,8 @@ def test_fuzz_random_json_raises_only_bgr_errors(data):
 _SMALL = terminals(
     bgr.derive(
         bgr.load(
-            "terminal W, N\nLot --> s(6, 0, 4) extrude(3) comp(f) { side: split(x) { ~1: W | 1: N | ~1: W }* | all: NIL }\n"
+            "terminal W, N\nLot --> s(6, 0, 4) extrude(3) comp(f) { side: split(x) { ~1: W | 1: N "
+            "| ~1: W }* | all: NIL }\n"
         )
     )
 )
@@ -402,7 +408,9 @@ def test_grammars_with_3d_parts_give_one_face_per_wall(name, blocks):
 FRONT_DOOR = """\
 terminal Wall, Door, Window
 Lot --> extrude(8) comp(f) { front: F | side: Wall | top: NIL | bottom: NIL }
-F --> split(x) { ~1: Wall | 1.2: split(y) { 2.4: Door | ~1: Wall } | { ~1: Wall | 1.2: Window }* | ~1: Wall }
+F --> split(x) {
+    ~1: Wall | 1.2: split(y) { 2.4: Door | ~1: Wall } | { ~1: Wall | 1.2: Window }* | ~1: Wall
+}
 """
 
 
@@ -459,9 +467,11 @@ def test_round_trip_on_geojson_lots_keeps_each_face_on_its_side(rings, tmp_path)
 @pytest.mark.parametrize(
     "front",
     [
-        "split(x) { { ~1: Wall | 1.2: split(y) { 2.5: Door } | ~1: Wall }* }",  # a door shorter than its column
+        # a door shorter than its column
+        "split(x) { { ~1: Wall | 1.2: split(y) { 2.5: Door } | ~1: Wall }* }",
         (
-            "split(x) { 1: Pier | 1.5: Window | 1: Pier | 1.5: Window | 1: Pier | 1.5: Window | 1: Pier | 2: Door "
+            "split(x) { 1: Pier | 1.5: Window | 1: Pier | 1.5: Window | 1: Pier | 1.5: Window | 1: "
+            "Pier | 2: Door "
             "| 1: Pier | 1.5: Window | 1: Pier | 1.5: Window | 1: Pier | ~1: Wall }"
         ),  # bays, a door, bays
     ],
@@ -469,7 +479,8 @@ def test_round_trip_on_geojson_lots_keeps_each_face_on_its_side(rings, tmp_path)
 def test_round_trip_of_nested_gaps_and_tied_groups(front):
     src_text = (
         "terminal Wall, Window, Door, Pier\n"
-        f"Lot --> s(17, 0, 10) extrude(4) comp(f) {{ front: {front} | side: Wall | top: NIL | bottom: NIL }}\n"
+        "Lot --> s(17, 0, 10) extrude(4) comp(f) "
+        f"{{ front: {front} | side: Wall | top: NIL | bottom: NIL }}\n"
     )
     src = bgr.derive(bgr.load(src_text))
     text = bgr.format_module(infer(src))
@@ -484,8 +495,10 @@ def test_a_face_with_an_edge_gap_is_kept():
     src = bgr.derive(
         bgr.load(
             "terminal Wall, Window\n"
-            "Lot --> s(20, 0, 12) extrude(6) comp(f) { front: F | side: Wall | top: NIL | bottom: NIL }\n"
-            "F --> split(x) { 1: Wall | 1: Wall | 1: Wall | 2: Window | 1: Wall | 1: Wall | 1.5: Wall }\n"
+            "Lot --> s(20, 0, 12) extrude(6) comp(f) { front: F | side: Wall | top: NIL | bottom: "
+            "NIL }\n"
+            "F --> split(x) { 1: Wall | 1: Wall | 1: Wall | 2: Window | 1: Wall | 1: Wall | 1.5: "
+            "Wall }\n"
         )
     )
     model = read_model(src)

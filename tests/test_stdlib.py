@@ -6,10 +6,10 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from bgr.grammar.docstrings import rule_docs
 from conftest import ROOT
 
 import bgr
+from bgr.grammar.docstrings import rule_docs
 
 STDLIB = ROOT / "stdlib"
 SEEDS = range(5)

@@ -13,12 +13,12 @@ import numpy as np
 import pygltflib
 import pytest
 import trimesh
+
+from bgr import BgrError
 from bgr.interpreter.terminals import TerminalTable, UnitMesh, color_hex
 from bgr.interpreter.writers import glb as glb_module
 from bgr.interpreter.writers import read_glb, to_trimesh, write, write_json
 from bgr.interpreter.writers.glb_read import parse, quat_matrix
-
-from bgr import BgrError
 
 QUAD_V = [[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0]]
 QUAD_F = [[0, 1, 2], [0, 2, 3]]
@@ -75,7 +75,7 @@ def city_table(boxes: int = 40, quads: int = 30, seed: int = 1) -> TerminalTable
     t = TerminalTable()
     quad = t.library.add(UnitMesh("quad", QUAD_V, QUAD_F))
     box = t.library.add(UnitMesh("cube", BOX_V, BOX_F))
-    for i in range(boxes):
+    for _ in range(boxes):
         add(
             t,
             "Mass",

@@ -1,1 +1,1 @@
-"""Geometry helpers of the interpreter: polygons, prisms, primitives, roofs. No language code here."""
+"""Geometry helpers of the interpreter: polygons, prisms, primitives, roofs; no language code."""

@@ -61,7 +61,7 @@ def prism_mesh(polys, k: int) -> tuple[np.ndarray, np.ndarray]:
         for ring, is_hole in [(ext, False)] + [(h, True) for h in holes]:
             ring = np.asarray(ring, dtype=np.float64)
             nxt = np.roll(ring, -1, axis=0)
-            for p, q in zip(ring, nxt):
+            for p, q in zip(ring, nxt, strict=True):
                 quad = np.vstack([_lift(np.array([p, q]), k, 0.0), _lift(np.array([q, p]), k, 1.0)])
                 # outward: away from the ring's interior (towards it for holes)
                 edge = q - p

@@ -129,13 +129,13 @@ def triangulate(polys: list[Poly]) -> tuple[np.ndarray, np.ndarray]:
 
 def signed_area(ring) -> float:
     a = 0.0
-    for (x0, y0), (x1, y1) in zip(ring, ring[1:] + ring[:1]):
+    for (x0, y0), (x1, y1) in zip(ring, ring[1:] + ring[:1], strict=True):
         a += x0 * y1 - x1 * y0
     return a / 2.0
 
 
 def named_footprint(kind: str, a: float, b: float) -> list[Poly]:
-    """A building outline in the unit square, counter-clockwise, its first edge on the front (v = 0).
+    """A building outline in the unit square, counter-clockwise, first edge on the front (v = 0).
 
     ``a`` and ``b`` are wing widths as fractions of the scope (``a`` along u, ``b`` along v);
     for ``circle`` ``a`` is the number of sides, the first side centred on the front so that
@@ -170,7 +170,11 @@ def named_footprint(kind: str, a: float, b: float) -> list[Poly]:
         n = int(a)
         angles = -np.pi / 2 - np.pi / n + 2 * np.pi * np.arange(n) / n
         ring = tuple(
-            zip((0.5 + 0.5 * np.cos(angles)).tolist(), (0.5 + 0.5 * np.sin(angles)).tolist())
+            zip(
+                (0.5 + 0.5 * np.cos(angles)).tolist(),
+                (0.5 + 0.5 * np.sin(angles)).tolist(),
+                strict=True,
+            )
         )
     else:
         raise ValueError(f"unknown footprint {kind!r}")

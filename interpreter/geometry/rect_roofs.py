@@ -18,7 +18,9 @@ import numpy as np
 def rectangle_hip(
     width: float, depth: float, pitch: float, overhang: float = 0.0
 ) -> tuple[np.ndarray, np.ndarray]:
-    """(vertices (6, 3), faces (6, 3)) of a hip roof on [0, width] x [0, depth], z up, CCW from above."""
+    """(vertices (6, 3), faces (6, 3)) of a hip roof on [0, width] x [0, depth], z up, CCW from
+    above.
+    """
     if width < depth:  # build it along x, then turn it a quarter (a rotation keeps the winding)
         v, f = rectangle_hip(depth, width, pitch, overhang)
         return np.column_stack([width - v[:, 1], v[:, 0], v[:, 2]]), f

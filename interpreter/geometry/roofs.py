@@ -239,10 +239,15 @@ class _MeshBuilder:
         self.planes: list[RoofPlane] = []
         self.keys: dict = {}
 
-    def plane(self, key, make) -> int:
+    def plane(self, key, make, *args) -> int:
+        """The index of the plane under ``key``, made by ``make(*args)`` the first time.
+
+        The arguments are passed, not captured by a closure, so a plane made inside a loop
+        reads that iteration's values whenever it is made.
+        """
         if key not in self.keys:
             self.keys[key] = len(self.planes)
-            self.planes.append(make())
+            self.planes.append(make(*args))
         return self.keys[key]
 
     def add(self, tris, plane: int) -> None:
@@ -350,15 +355,16 @@ def _skeleton_roof(fp: _Footprint, kind: str, pitch: float, overhang: float) -> 
                 lower = overhang - overhang * weights[edge]
                 plane = builder.plane(
                     ("slope", edge, stage, lower),
-                    lambda: _slope_plane(
-                        fp, edge, tans[stage], inset * stage + lower, tans[0] * inset * stage
-                    ),
+                    _slope_plane,
+                    fp,
+                    edge,
+                    tans[stage],
+                    inset * stage + lower,
+                    tans[0] * inset * stage,
                 )
                 flat = sk.nodes[:, :2]
             else:
-                plane = builder.plane(
-                    ("gable", edge), lambda: _wall_plane(fp, edge, "gable", pts[edge])
-                )
+                plane = builder.plane(("gable", edge), _wall_plane, fp, edge, "gable", pts[edge])
                 flat = np.column_stack([sk.nodes[:, :2] @ d[k], sk.nodes[:, 2]])
             for cycle in cycles:
                 builder.add_polygon(cycle, flat[cycle], plane)
@@ -505,16 +511,9 @@ def _pyramid_roof(fp: _Footprint, pitch: float, overhang: float, apex: np.ndarra
         a, b = np.append(pts[k], 0.0), np.append(pts[(k + 1) % n], 0.0)
         normal = _unit(np.cross(b - a, np.append(apex, height) - a))
         run = float(nrm[k] @ apex - c[k])  # horizontal distance from the edge to the apex
+        slope = math.degrees(math.atan2(height, run))
         plane = builder.plane(
-            k,
-            lambda: RoofPlane(
-                "slope",
-                fp.label[k],
-                fp.edges[k],
-                normal,
-                float(normal @ a),
-                math.degrees(math.atan2(height, run)),
-            ),
+            k, RoofPlane, "slope", fp.label[k], fp.edges[k], normal, float(normal @ a), slope
         )
         builder.add([[k, (k + 1) % n, n]], plane)
     return builder.finish(eave, overhang, "pyramid")
@@ -542,14 +541,14 @@ def _shed_roof(fp: _Footprint, pitch: float, overhang: float) -> RoofMesh:
     )
     below = np.where(low, np.arange(n), np.arange(n) + n)
     builder = _MeshBuilder(vertices)
-    roof = builder.plane("roof", lambda: _slope_plane(fp, f, tan, behind, 0.0))
+    roof = builder.plane("roof", _slope_plane, fp, f, tan, behind, 0.0)
     builder.add_polygon(np.arange(n), ring, roof)
     for i in range(n):
         j = (i + 1) % n
         if low[i] and low[j]:
             continue
         edge = int(source[i])
-        wall = builder.plane(("wall", edge), lambda: _wall_plane(fp, edge, "wall", ring[i]))
+        wall = builder.plane(("wall", edge), _wall_plane, fp, edge, "wall", ring[i])
         quad = [tri for tri in ([below[i], below[j], j], [below[i], j, i]) if len(set(tri)) == 3]
         builder.add(quad, wall)
     return builder.finish(vertices[below], overhang, "shed")
@@ -560,8 +559,6 @@ def _flat_roof(fp: _Footprint, overhang: float) -> RoofMesh:
     ring, _ = _eave_ring(fp, overhang, np.ones(len(fp.points)))
     vertices = np.column_stack([ring, np.zeros(len(ring))])
     builder = _MeshBuilder(vertices)
-    plane = builder.plane(
-        "flat", lambda: RoofPlane("flat", None, (), np.array([0.0, 0.0, 1.0]), 0.0, 0.0)
-    )
+    plane = builder.plane("flat", RoofPlane, "flat", None, (), np.array([0.0, 0.0, 1.0]), 0.0, 0.0)
     builder.add_polygon(np.arange(len(ring)), ring, plane)
     return builder.finish(vertices, overhang, "flat")

@@ -267,19 +267,22 @@ class _Wavefront:
         rings = []
         for poly in polys:
             ids = [self._node(vx.p, time) for vx in poly]
-            for vx, nid in zip(poly, ids):
+            for vx, nid in zip(poly, ids, strict=True):
                 self._die(vx, nid)
             rings.append(ids)
         for stage_delta in (0, 1):
             if stage_delta:
                 self.stage += 1
                 self.segments.append([[] for _ in self.w])
-            for poly, ids in zip(polys, rings):
+            for poly, ids in zip(polys, rings, strict=True):
                 for q, vx in enumerate(poly):
                     self._segment(vx.e_out, ids[q], ids[(q + 1) % len(poly)])
         return [
-            [self._vertex(vx.p, time, vx.e_in, vx.e_out, nid) for vx, nid in zip(poly, ids)]
-            for poly, ids in zip(polys, rings)
+            [
+                self._vertex(vx.p, time, vx.e_in, vx.e_out, nid)
+                for vx, nid in zip(poly, ids, strict=True)
+            ]
+            for poly, ids in zip(polys, rings, strict=True)
         ]
 
     @staticmethod
@@ -407,7 +410,7 @@ class _Wavefront:
         """A polygon of zero area: its vertices die where they are, and its edges (ridges, or
         nothing at all) close the faces of their edges."""
         ids = [self._node(vx.p, time) for vx in poly]
-        for vx, nid in zip(poly, ids):
+        for vx, nid in zip(poly, ids, strict=True):
             self._die(vx, nid)
         for q, vx in enumerate(poly):
             self._segment(vx.e_out, ids[q], ids[(q + 1) % len(poly)])
@@ -472,7 +475,7 @@ def _assemble_faces(nodes: np.ndarray, segments, d: np.ndarray, w: np.ndarray):
     faces = []
     for stage in segments:
         per_edge = []
-        for k, segs in enumerate(stage):
+        for segs in stage:
             uniq = {tuple(sorted((int(rep[a]), int(rep[b])))) for a, b in segs}
             per_edge.append([s for s in uniq if s[0] != s[1]])
         faces.append(per_edge)
@@ -483,10 +486,9 @@ def _assemble_faces(nodes: np.ndarray, segments, d: np.ndarray, w: np.ndarray):
         cycles_of_stage = []
         for k, segs in enumerate(stage):
             segs = sorted({tuple(sorted(s)) for s in _split_at_nodes(segs, nodes, used)})
-            if w[k] > 0:
-                flat = nodes[:, :2]
-            else:  # a vertical face, seen from outside: (position along the edge, t)
-                flat = np.column_stack([nodes[:, :2] @ d[k], nodes[:, 2]])
+            # a sloped face is drawn from above; a vertical one from outside, as
+            # (position along the edge, t)
+            flat = nodes[:, :2] if w[k] > 0 else np.column_stack([nodes[:, :2] @ d[k], nodes[:, 2]])
             cycles_of_stage.append(_walk_cycles(segs, flat))
         out.append(cycles_of_stage)
     return out

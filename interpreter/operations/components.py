@@ -5,6 +5,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
+
 from bgr.grammar import nodes as n
 
 from ..expressions import runtime_error
@@ -71,7 +72,7 @@ def _faces(app, step, shape):
             outward_right = (ccw != is_hole) != (k == 1)
             turns = _turns(metric, outer_sign=(1 if ccw else -1) * (-1 if is_hole else 1))
             n = len(ring)
-            for i, ((u0, v0), (u1, v1)) in enumerate(zip(ring, ring[1:] + ring[:1])):
+            for i, ((u0, v0), (u1, v1)) in enumerate(zip(ring, ring[1:] + ring[:1], strict=True)):
                 a, b = point(u0, v0, 0), point(u1, v1, 0)
                 edge = [b[i] - a[i] for i in range(3)]
                 nrm = normalise(cross(edge, up) if outward_right else cross(up, edge))
@@ -319,15 +320,20 @@ def taper(app, shape, step, args) -> bool:
     if ratio > 0:
         faces.append(_orient(top, tris, lambda c: np.broadcast_to(up, c.shape)) + len(bottom))
     base, middle = len(bottom) + len(top), np.array([*centre, 0.5])
+    mid3 = _lift(middle[None, :2], k, 0.5)[0]
+
+    def outward(c: np.ndarray) -> np.ndarray:
+        """A side quad's normal points away from the taper's middle."""
+        return c - mid3
+
     for ext, holes in polys:
         for ring in [ext, *holes]:
-            for a, b in zip(ring, ring[1:] + ring[:1]):
+            for a, b in zip(ring, ring[1:] + ring[:1], strict=True):
                 quad2 = np.array([a, b, b, a], dtype=float)
                 lifted = np.vstack(
                     [_lift(quad2[:2], k, 0.0), _lift(centre + (quad2[2:] - centre) * ratio, k, 1.0)]
                 )
-                mid3 = _lift(middle[None, :2], k, 0.5)[0]
-                quad_faces = _orient(lifted, np.array([[0, 1, 2], [0, 2, 3]]), lambda c: c - mid3)
+                quad_faces = _orient(lifted, np.array([[0, 1, 2], [0, 2, 3]]), outward)
                 verts.append(lifted)
                 faces.append(quad_faces + base)
                 base += 4

@@ -5,6 +5,7 @@ from __future__ import annotations
 from pathlib import Path
 
 import numpy as np
+
 from bgr.grammar.registry import PRIMITIVES
 
 from ..expressions import runtime_error

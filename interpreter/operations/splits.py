@@ -41,7 +41,7 @@ def _items(entries, sizes: tuple) -> tuple:
         Repeat(_items(entry.entries, size))
         if isinstance(entry, n.Group)
         else Piece(entry.kind, size, entry)
-        for entry, size in zip(entries, sizes)
+        for entry, size in zip(entries, sizes, strict=True)
     )
 
 

@@ -11,6 +11,7 @@ file behind.  Failures a user can act on (unknown format, unwritable folder) are
 from __future__ import annotations
 
 import sys
+from collections.abc import Callable
 from pathlib import Path
 
 from ...grammar.errors import BgrError, Diagnostic
@@ -25,7 +26,8 @@ from .stl import write_stl
 from .terminal_json import write_json, write_json_bytes
 
 # format name -> writer(table, binary stream, *, seed, attrs); obj is special (two files)
-FORMATS = {
+# the writer of each format: (table, binary stream, seed=, attrs=) -> None
+FORMATS: dict[str, Callable[..., None]] = {
     "glb": write_glb,
     "gltf": write_gltf,
     "obj": write_obj,

@@ -61,7 +61,7 @@ def atomic_files(targets: list[Path]) -> Iterator[list[BinaryIO]]:
             temps.append(_open_temp(target))
         current = targets[0]
         yield [f for _, f in temps]
-        for (tmp, f), target in zip(temps, targets):
+        for (tmp, f), target in zip(temps, targets, strict=True):
             current = target
             f.close()
             if target.exists():  # keep the permissions of the file being replaced

@@ -204,7 +204,7 @@ class _Builder:
     def accessor(
         self, view: int, first: int = 0, count: int | None = None, bounded: bool = False
     ) -> int:
-        """An accessor on elements ``first:first + count`` of a view; with min/max if ``bounded``."""
+        """An accessor on elements ``first:first + count`` of a view, min/max if ``bounded``."""
         data = self._data[view]
         count = len(data) - first if count is None else count
         acc = {
@@ -267,7 +267,9 @@ def build(
         mat_of_row = mats.index[p.baked]
         cuts = np.flatnonzero(np.diff(mat_of_row)) + 1
         prims = []
-        for lo, hi in zip(np.concatenate([[0], cuts]), np.concatenate([cuts, [len(mat_of_row)]])):
+        for lo, hi in zip(
+            np.concatenate([[0], cuts]), np.concatenate([cuts, [len(mat_of_row)]]), strict=True
+        ):
             first, count = 3 * int(fstart[lo]), 3 * int(fstart[hi] - fstart[lo])
             if count:
                 prims.append(
@@ -377,17 +379,20 @@ def write_glb(
     attrs: dict,
     instancing: str | bool = "auto",
 ) -> None:
-    """A binary glTF: header, JSON chunk (space-padded), BIN chunk.  ``instancing``: see :func:`plan`."""
+    """A binary glTF: header, JSON chunk (space-padded), BIN chunk.
+
+    ``instancing``: see :func:`plan`.
+    """
     gltf, bin_ = build(table, seed=seed, attrs=attrs, instancing=instancing)
     text = _json_bytes(gltf)
     text += b" " * (-len(text) % 4)
-    chunks = [struct.pack("<II", len(text), 0x4E4F534A), text]
+    chunks: list[bytes | np.ndarray] = [struct.pack("<II", len(text), 0x4E4F534A), text]
     if bin_.nbytes:
         chunks += [struct.pack("<II", bin_.nbytes, 0x004E4942), bin_]  # already a multiple of 4
     total = 12 + sum(len(c) if isinstance(c, bytes) else c.nbytes for c in chunks)
     stream.write(struct.pack("<4sII", b"glTF", 2, total))
     for c in chunks:
-        stream.write(c if isinstance(c, bytes) else memoryview(c))
+        stream.write(c if isinstance(c, bytes) else c.data)
 
 
 def write_gltf(

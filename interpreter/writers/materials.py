@@ -25,7 +25,7 @@ class Materials:
         return len(self.names)
 
     def hex(self, k: int) -> str:
-        return "#%02x%02x%02x" % tuple(int(c) for c in self.rgb8[k])
+        return "#" + "".join(f"{int(c):02x}" for c in self.rgb8[k])
 
     def linear(self, k: int) -> list[float]:
         """The colour in linear light (glTF's baseColorFactor), from its sRGB bytes."""
@@ -60,6 +60,6 @@ def materials_of(table: TerminalTable) -> Materials:
     for n in names:
         colours_per_name[n] = colours_per_name.get(n, 0) + 1
     for k, n in enumerate(names):
-        hx = "#%02x%02x%02x" % tuple(int(c) for c in rgb8[k])
+        hx = "#" + "".join(f"{int(c):02x}" for c in rgb8[k])
         labels.append(hx if n is None else (n if colours_per_name[n] == 1 else f"{n} {hx}"))
     return Materials(index=index.astype(np.int64), rgb8=rgb8, names=names, labels=labels)

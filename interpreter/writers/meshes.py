@@ -213,7 +213,9 @@ def place_corners(
     vpool = pool.vertices.astype(f32)
 
     def corners(sel: np.ndarray, F: int, out: np.ndarray) -> None:
-        """World corners of the rows ``sel`` (one shape, F faces each) into out (len(sel) * F, 3, 3)."""
+        """World corners of the rows ``sel`` (one shape, F faces each) into out (len(sel) * F, 3,
+        3).
+        """
         m = mesh[sel]
         if m[0] == m[-1] and (m == m[0]).all():  # one shared unit mesh
             lo = pool.foff[m[0]]

@@ -48,7 +48,9 @@ def write_obj(
     _rows(stream, "v %.9g %.9g %.9g\n", baked.vertices)
     mat_of_face = np.repeat(mats.index[rows], np.diff(baked.fstart))
     cuts = np.flatnonzero(np.diff(mat_of_face)) + 1
-    for lo, hi in zip(np.concatenate([[0], cuts]), np.concatenate([cuts, [len(mat_of_face)]])):
+    for lo, hi in zip(
+        np.concatenate([[0], cuts]), np.concatenate([cuts, [len(mat_of_face)]]), strict=True
+    ):
         if hi > lo:
             stream.write(f"usemtl {names[mat_of_face[lo]]}\n".encode())
             _rows(stream, "f %d %d %d\n", baked.faces[lo:hi] + 1)

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from typing import BinaryIO
+from typing import Any, BinaryIO
 
 import numpy as np
 import trimesh
@@ -17,8 +17,7 @@ def write_ply(table: TerminalTable, stream: BinaryIO, *, seed: int, attrs: dict)
     baked = bake(table)
     rgba = np.full((len(baked.vertices), 4), 255, dtype=np.uint8)
     rgba[:, :3] = np.repeat(srgb8(table), np.diff(baked.vstart), axis=0)
-    colours = (
-        {"vertex_colors": rgba} if len(rgba) else {}
-    )  # trimesh cannot export 0 coloured vertices
+    # trimesh cannot export 0 coloured vertices
+    colours: dict[str, Any] = {"vertex_colors": rgba} if len(rgba) else {}
     mesh = trimesh.Trimesh(baked.vertices, baked.faces, process=False, **colours)
     stream.write(export_ply(mesh, encoding="binary", vertex_normal=False, include_attributes=False))

@@ -83,6 +83,7 @@ def terminal_dicts(table: TerminalTable) -> list[dict]:
                 colours,
                 table.material,
                 table.geometry_names(),
+                strict=True,
             )
         ]
 

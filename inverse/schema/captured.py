@@ -51,8 +51,9 @@ _COORD = {"$ref": "#/$defs/coordinate"}
 SCHEMA: dict = {
     "$schema": "https://json-schema.org/draft/2020-12/schema",
     "title": "bgr captured model",
-    "description": "A building captured by hand, Build-by-Number style: blocks (box, cylinder, prism) in a "
-    "scene graph, cut into floors, each face of each floor subdivided into labelled subfaces. "
+    "description": "A building captured by hand, Build-by-Number style: blocks (box, cylinder, "
+    "prism) in a scene graph, cut into floors, each face of each floor subdivided into labelled "
+    "subfaces. "
     "See docs/inverse-schema.md, section 'Captured-model JSON'.",
     "type": "object",
     "required": ["bgr_captured", "blocks"],
@@ -65,8 +66,8 @@ SCHEMA: dict = {
         "name": {"type": "string", "description": "the building's name, free text"},
         "labels": {
             "type": "object",
-            "description": "per label, whether its size is fixed (windows, doors) or stretches (brick); "
-            "labels not listed are fixed when they contain window, door, entrance, entry, "
+            "description": "per label, whether its size is fixed (windows, doors) or stretches "
+            "(brick); labels not listed are fixed when they contain window, door, entrance, entry, "
             "portal or gate",
             "propertyNames": {"$ref": "#/$defs/label"},
             "additionalProperties": {"$ref": "#/$defs/labelInfo"},
@@ -94,8 +95,8 @@ SCHEMA: dict = {
         "label": {
             "type": "string",
             "pattern": IDENTIFIER,
-            "description": "a label: an identifier (letters, digits and _, not starting with a digit), "
-            "as it names a terminal of the inferred grammar",
+            "description": "a label: an identifier (letters, digits and _, not starting with a "
+            "digit), as it names a terminal of the inferred grammar",
         },
         "labelInfo": {
             "type": "object",
@@ -155,7 +156,8 @@ SCHEMA: dict = {
                 "transform": {
                     "type": "object",
                     "additionalProperties": False,
-                    "description": '{"translate": [x, y, z], "rotate": degrees about y}, relative to the parent',
+                    "description": '{"translate": [x, y, z], "rotate": degrees about y}, '
+                    "relative to the parent",
                     "properties": {
                         "translate": {
                             "type": "array",
@@ -175,7 +177,8 @@ SCHEMA: dict = {
                 },
                 "parent": {
                     "type": ["string", "null"],
-                    "description": "the id of the block this one's transform is relative to, or null",
+                    "description": "the id of the block this one's transform is relative to, "
+                    "or null",
                 },
                 "attach": {
                     "type": "array",
@@ -790,7 +793,8 @@ class _Reader:
                     other = blocks[target]
                     self.fail(
                         f"{where}.to_face",
-                        f"{att['to_face']!r} is not a face of block {att['to']!r} (a {other['shape']})",
+                        f"{att['to_face']!r} is not a face of block {att['to']!r} (a "
+                        f"{other['shape']})",
                         suggest(att["to_face"], _face_names(other)) or _names_hint(other),
                     )
         return ids
@@ -1092,7 +1096,7 @@ def model_from_captured(
         + [f for f in all_faces if id(f) in start_covered]
     )
     model_blocks = []
-    for b, faces, ring in zip(blocks, kept, built):
+    for b, faces, ring in zip(blocks, kept, built, strict=True):
         w, h, d = (float(v) for v in b["size"])
         plan = [(f.origin[0], f.origin[2]) for _, f in ring]  # every face, hidden ones too
         model_blocks.append(Block(b["id"], faces, w, d, h, b["shape"], footprint=plan))

@@ -256,7 +256,8 @@ class Emitter:
         leaves = sum(f.root.count() for f in self.model.faces())
         header = [
             f"# Inferred by bgr infer --kind schema from {self.model.source or 'a model'}:",
-            f"# {faces} faces, {leaves} subfaces; {len(self.rules)} schema rules. Derive it on a lot:",
+            f"# {faces} faces, {leaves} subfaces; {len(self.rules)} schema rules. Derive it on a "
+            "lot:",
             "#   bgr derive THIS.bgr --lot W,D|LOTS.geojson -o out.glb   (--set height=H)",
         ]
         if self.model.dropped:
@@ -392,7 +393,7 @@ def _reproduces(entries, parts: list[Cell], length: float) -> bool:
     placed = solver.solve([item(e) for e in entries], length)
     if len(placed) != len(parts):
         return False
-    return all(abs(p.size - c.size) < 1e-7 for p, c in zip(placed, parts))
+    return all(abs(p.size - c.size) < 1e-7 for p, c in zip(placed, parts, strict=True))
 
 
 # ---- floor-schema choice -------------------------------------------------------------------

@@ -157,12 +157,12 @@ def unroll(
     keep = [min(n, k + 1) for n in counts]
     if widths is not None:
         pair = [widths[s.first_index] + widths[s.second_index] for s in stars(items)]
-        width = sum(n * p for n, p in zip(keep, pair))
+        width = sum(n * p for n, p in zip(keep, pair, strict=True))
         for extra in itertools.product((0, 1), repeat=len(keep)):
             other = [k + e for e in extra]
-            if other != keep and abs(sum(n * p for n, p in zip(other, pair)) - width) <= EPS * max(
-                1.0, width
-            ):
+            if other != keep and abs(
+                sum(n * p for n, p in zip(other, pair, strict=True)) - width
+            ) <= EPS * max(1.0, width):
                 keep = [k] * len(counts)
                 break
     return _pull(items, counts, keep)
@@ -170,7 +170,7 @@ def unroll(
 
 def _pull(items: Sequence[Item], counts: Sequence[int], keep: Sequence[int]) -> list[Item]:
     """Each star with ``keep`` repetitions, followed by the rest of its ``counts`` as columns."""
-    reps = iter(zip(counts, keep))
+    reps = iter(zip(counts, keep, strict=True))
     out: list[Item] = []
     for item in items:
         if isinstance(item, Sym):
@@ -225,8 +225,8 @@ def retarget(
     best: tuple[tuple[int, ...], float, float] | None = None  # counts, scale, distance
     for extra in itertools.product((0, 1), repeat=len(groups)):
         counts = tuple(k + e for e in extra)
-        fixed_width = out_fixed + sum(c * a for c, (a, _) in zip(counts, groups))
-        var_width = out_var + sum(c * f for c, (_, f) in zip(counts, groups))
+        fixed_width = out_fixed + sum(c * a for c, (a, _) in zip(counts, groups, strict=True))
+        var_width = out_var + sum(c * f for c, (_, f) in zip(counts, groups, strict=True))
         if stretchy:
             if var_width <= 0 or length - fixed_width <= 0:
                 continue  # no variable column to scale, or no room left for them

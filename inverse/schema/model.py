@@ -44,7 +44,8 @@ class Cell:
 
     def key(self) -> str:
         """The equality relation of Build-by-Number: a leaf is its label, a subdivided cell its
-        rewrite string (the keys of its parts, with their sizes — see ``docs/inverse-schema.md``)."""
+        rewrite string (the keys of its parts, with their sizes — see ``docs/inverse-schema.md``).
+        """
         if self.is_leaf:
             return self.label or "_"
         inner = ",".join(
