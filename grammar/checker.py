@@ -24,6 +24,8 @@ from .registry import (
     COMP_KIND,
     COMP_KINDS,
     COMP_SELECTORS,
+    EXTRUDE_KIND,
+    EXTRUDE_KINDS,
     FOOTPRINT_KIND,
     FOOTPRINT_KINDS,
     GEOMETRY,
@@ -46,6 +48,7 @@ _SYMBOL_KINDS = {
     COMP_KIND: COMP_KINDS,
     ROOF_KIND: ROOF_KINDS,
     FOOTPRINT_KIND: FOOTPRINT_KINDS,
+    EXTRUDE_KIND: EXTRUDE_KINDS,
 }
 _RESERVED_ALIASES = {"scope", "split", "comp", "stdlib"}
 
@@ -382,8 +385,18 @@ class Checker:
             for arg, param in zip(step.args, signature, strict=False):
                 self.op_arg(arg, param.kind, param.name, op, local)
         else:
+            # no signature fits (reported): check the expressions, but not a bare word that one
+            # of the operation's signatures takes (extrude(world.up, 1, 2) is one mistake)
+            words = {
+                word
+                for sig in op.signatures
+                for p in sig
+                if p.kind in _SYMBOL_KINDS
+                for word in _SYMBOL_KINDS[p.kind]
+            }
             for arg in step.args:
-                self.arg(arg, local, relative_ok=True)
+                if not (isinstance(arg, n.Name) and arg.name in words):
+                    self.arg(arg, local, relative_ok=True)
         if op.block is None:
             if step.block is not None:  # the grammar lets any call carry a block
                 self.error(step.block.pos, f"'{op.name}' takes no {{ }} block")

@@ -21,12 +21,14 @@ AXES = "axes"  # a non-empty combination of x, y, z: xz, xyz ...
 COMP_KIND = "comp kind"  # f (faces)
 ROOF_KIND = "roof kind"  # flat | gable | ...
 FOOTPRINT_KIND = "footprint kind"  # rect | L | U | T | cross | circle
+EXTRUDE_KIND = "extrusion direction"  # face.normal | world.up
 GEOMETRY = "geometry"  # a primitive or a declared asset
 
 AXIS_NAMES = ("x", "y", "z")
 COMP_KINDS = ("f",)
 ROOF_KINDS = ("flat", "gable", "hip", "pyramid", "shed", "mansard", "gambrel")
 FOOTPRINT_KINDS = ("rect", "L", "U", "T", "cross", "circle")
+EXTRUDE_KINDS = ("face.normal", "world.up")
 PRIMITIVES = ("cube", "cylinder", "sphere", "quad", "wedge")
 COMP_SELECTORS = ("front", "back", "left", "right", "side", "top", "bottom", "all")
 OFFSET_SELECTORS = ("inside", "border")
@@ -153,8 +155,14 @@ OPERATIONS: dict[str, Op] = {
         Op(
             "extrude",
             "components",
-            _sig(Param("height", NUMBER)),
-            "Turn a 2D shape into a prism of the given height along its normal.",
+            (
+                (Param("height", NUMBER),),
+                (Param("direction", EXTRUDE_KIND), Param("height", NUMBER)),
+            ),
+            "Turn a 2D shape into a prism of the given height along its normal (a negative "
+            "height extrudes against it), or along world y with `world.up`. As in CGA, the "
+            "new scope's y points along the extrusion, x keeps its direction as far as it "
+            "can, and z completes a right-handed frame.",
             "extrude(12)",
         ),
         Op(

@@ -17,6 +17,7 @@ from bgr.grammar.registry import (
     AXES,
     AXIS,
     COMP_KIND,
+    EXTRUDE_KIND,
     FOOTPRINT_KIND,
     GEOMETRY,
     OPERATIONS,
@@ -31,7 +32,7 @@ from .randomness import Stream, child_hash, name_hash, root_hash
 from .shapes import Flat, Shape, Solid
 from .terminals import TerminalTable, UnitMesh
 
-SYMBOL_KINDS = {AXIS, AXES, COMP_KIND, ROOF_KIND, FOOTPRINT_KIND, GEOMETRY}
+SYMBOL_KINDS = {AXIS, AXES, COMP_KIND, ROOF_KIND, FOOTPRINT_KIND, EXTRUDE_KIND, GEOMETRY}
 EMIT = object()  # marks a children-list entry that is a finished terminal, kept in order
 _NAME_HASHES: dict[str, int] = {}
 

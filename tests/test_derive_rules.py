@@ -118,8 +118,10 @@ def test_division_by_zero_names_the_place():
 def test_extruding_a_3d_shape_and_negative_sizes_are_errors():
     with pytest.raises(bgr.BgrError, match="already 3D"):
         bgr.derive(bgr.load("Lot --> extrude(1) extrude(2)\n"))
+    # extrude(-1) is CGA's extrusion against the normal (tests/test_scope_frames.py), but a
+    # taper is still a height
     with pytest.raises(bgr.BgrError, match="negative height"):
-        bgr.derive(bgr.load("Lot --> extrude(-1)\n"))
+        bgr.derive(bgr.load("Lot --> taper(-1, 0.5)\n"))
     with pytest.raises(bgr.BgrError, match="negative size"):
         bgr.derive(bgr.load("Lot --> s(-1, 1, 1)\n"))
 

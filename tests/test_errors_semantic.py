@@ -117,11 +117,11 @@ CASES = [
         id="func-wrong-arg-count",
     ),
     pytest.param(
-        "Lot --> extrude(1, 2)\n",
+        "Lot --> extrude(world.up, 1, 2)\n",
         1,
         9,
-        "'extrude' takes 1 argument",
-        "write extrude(height)",
+        "'extrude' takes 1 or 2 arguments, given 3",
+        "write extrude(height) or extrude(direction, height)",
         id="operation-too-many-args",
     ),
     pytest.param(

@@ -68,7 +68,7 @@ def test_text_imports_resolve_from_the_given_path(tmp_path):
 
 def test_every_error_is_reported_not_only_the_first():
     with pytest.raises(bgr.BgrError) as e:
-        bgr.load("A --> B1\nB --> C1\nC --> extrude(1, 2)\n")
+        bgr.load("A --> B1\nB --> C1\nC --> extrude(world.up, 1, 2)\n")
     assert [(d.line, d.column) for d in e.value.diagnostics] == [(1, 7), (2, 7), (3, 7)]
     assert (e.value.line, e.value.column) == (1, 7)
 

@@ -389,7 +389,7 @@ def test_floor_schema_prefers_the_face_with_fewest_occluded_subfaces():
 
 
 @pytest.mark.parametrize(
-    "name, blocks", [("house.bgr", 1), ("stdlib_street.bgr", 1), ("tower.bgr", 2)]
+    "name, blocks", [("house.bgr", 1), ("stdlib_street.bgr", 1), ("tower.bgr", 3)]
 )
 def test_grammars_with_3d_parts_give_one_face_per_wall(name, blocks):
     """Recessed glass, frames, sills and reveals at right angles belong to the wall they are set

@@ -9,6 +9,7 @@ import numpy as np
 from bgr.grammar import nodes as n
 
 from ..expressions import runtime_error
+from ..geometry.frames import WORLD_UP, extrusion_axes, reframe_flat
 from ..geometry.meshes import PLANE_AXES
 from ..geometry.polygons import (
     RECT,
@@ -293,16 +294,104 @@ def footprint(app, shape, step, args) -> bool:
     return False
 
 
-def extrude(app, shape, step, args) -> bool:
+def _signed_height(app, step, value) -> float:
+    if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
+        raise runtime_error(
+            app.module, step.pos, f"{step.name}() needs a finite number, got {value!r}"
+        )
+    return float(value)
+
+
+def _into_extrusion_frame(app, step, shape, direction: str, height: float):
+    """Give ``shape`` the scope CGA gives an extruded shape; its 2D outline in that scope.
+
+    y points along the extrusion (the face's normal, or world y for ``world.up``), x keeps its
+    old direction as far as it can, z completes a right-handed frame (``geometry.frames``).  A
+    negative height extrudes against the normal: the scope's y still follows the normal (CGA
+    reports a negative scope.sy there; bgr keeps sizes positive and moves the origin down y).
+    Returns (outline flat along y, heights of its points above the scope's origin along y:
+    all 0 unless a tilted face is extruded along world y).
+    """
     geom = _flat(app, step, shape)
-    shape.size[geom.k] = _height(app, step, args[0])
-    shape.geom = Prism(geom.k, geom.polys)
+    axes = shape.axes
+    normal = axes[geom.k]
+    along = WORLD_UP if direction == "world.up" else normal
+    if geom.k == 1 and along == normal:  # a lot or a piece of one: the frame stays as it is
+        flat, heights = geom, None
+    elif geom.k == 2 and along == normal and geom.polys == RECT:  # a face: x, z, -y
+        w, h = shape.size[0], shape.size[1]
+        shape.origin = [shape.origin[i] + h * axes[1][i] for i in range(3)]
+        shape.axes = (axes[0], axes[2], tuple(-c for c in axes[1]))
+        shape.size = [w, 0.0, h]
+        flat, heights = Flat(1, RECT), None
+    else:
+        if abs(dot(along, normal)) < 1e-9:
+            raise runtime_error(
+                app.module,
+                step.pos,
+                f"{step.name}(world.up) of a vertical face has no volume",
+                "extrude a wall along its normal: extrude(d)",
+            )
+        frame = extrusion_axes(axes, along)
+        origin, size, polys, heights = reframe_flat(
+            shape.origin, axes, shape.size, geom.k, geom.polys, frame
+        )
+        shape.origin, shape.axes, shape.size = origin, frame, size
+        flat = Flat(1, polys)
+        if max(heights) <= 1e-9 * max(1.0, *size):
+            heights = None
+    if height < 0:
+        shape.origin = [shape.origin[i] + height * shape.axes[1][i] for i in range(3)]
+    return flat, heights
+
+
+def extrude(app, shape, step, args) -> bool:
+    given = len(step.args)  # extrude(height) or extrude(direction, height)
+    direction = args[0] if given == 2 else "face.normal"
+    height = _signed_height(app, step, args[given - 1])
+    flat, heights = _into_extrusion_frame(app, step, shape, direction, height)
+    if heights is None:
+        shape.size[1] = abs(height)
+        shape.geom = Prism(1, flat.polys)
+    else:
+        _sheared_prism(app, shape, flat, heights, height)
     return False
 
 
+def _sheared_prism(app, shape, flat: Flat, heights: list[float], height: float) -> None:
+    """A tilted face extruded along world y: a prism whose caps keep the face's slope."""
+    from ..geometry.meshes import prism_mesh
+
+    verts, faces = prism_mesh(flat.polys, 1)
+    w, d = shape.size[0], shape.size[2]
+    # the face is planar: its height above the origin is affine in (x, z); fit it from the
+    # points of the outline (least squares over all of them, exact for a plane)
+    pts = [
+        (u * w, v * d)
+        for ext, holes in ([(UNIT_SQUARE, ())] if flat.polys == RECT else flat.polys)
+        for ring in [ext, *holes]
+        for u, v in ring
+    ]
+    design = np.column_stack([np.ones(len(pts)), np.array(pts)])
+    coef, *_ = np.linalg.lstsq(design, np.array(heights), rcond=None)
+    base = coef[0] + coef[1] * verts[:, 0] * w + coef[2] * verts[:, 2] * d
+    y = base + verts[:, 1] * height
+    lo, hi = float(y.min()), float(y.max())
+    verts = verts.copy()
+    verts[:, 1] = (y - lo) / ((hi - lo) or 1.0)
+    if height < 0:  # the caps swapped sides: turn the triangles over
+        faces = faces[:, ::-1]
+    # the origin already sits at the lowest outline point (moved down by a negative height)
+    shift = lo - (min(0.0, height))
+    shape.origin = [shape.origin[i] + shift * shape.axes[1][i] for i in range(3)]
+    shape.size = [w, hi - lo, d]
+    mesh = UnitMesh("extrusion", verts, np.ascontiguousarray(faces))
+    shape.geom = Solid(app.engine.table.library.add(mesh), "extrusion")
+
+
 def taper(app, shape, step, args) -> bool:
-    geom = _flat(app, step, shape)
     height, ratio = _height(app, step, args[0]), args[1]
+    geom, _ = _into_extrusion_frame(app, step, shape, "face.normal", height)
     if isinstance(ratio, bool) or not isinstance(ratio, (int, float)) or ratio < 0:
         raise runtime_error(app.module, step.pos, f"taper() needs a ratio >= 0, got {ratio!r}")
     from ..geometry.meshes import _lift, _orient

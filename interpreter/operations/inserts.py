@@ -16,27 +16,38 @@ from ..terminals import UnitMesh
 def insert(app, shape, step, args) -> bool:
     name = args[0]
     if name in PRIMITIVES:
+        # CGA's built-in primitives fit a zero-size scope as assets do: a cube inserted into a
+        # face (z size 0) gets a depth, not a flattened box; ``quad`` is flat by nature
+        extent = (1.0, 1.0, 0.0) if name == "quad" else (1.0, 1.0, 1.0)
+        shape.size = fitted_size(shape.size, extent)
         shape.geom = Solid(app.engine.primitive_id(name), name)
         return False
     module, member = app.module.lookup_module(name)
     asset = module.assets[member]
     mesh_id, extent, offset = _load_asset(app, step, module, asset)
-    size = list(shape.size)
-    zero = [s <= 1e-12 for s in size]
-    if all(zero):  # keep the asset's own size and offset
-        size = list(extent)
+    if all(s <= 1e-12 for s in shape.size):  # keep the asset's own size and offset
         shape.origin = shape.world(offset)
-    elif sum(zero) == 2:  # scale uniformly by the non-zero axis
-        k = zero.index(False)
-        factor = size[k] / extent[k] if extent[k] else 1.0
-        size = [e * factor for e in extent]
-    elif sum(zero) == 1:  # that axis from the mean of the other two scale factors
-        k = zero.index(True)
-        factors = [size[i] / extent[i] for i in range(3) if i != k and extent[i]]
-        size[k] = extent[k] * (sum(factors) / len(factors) if factors else 1.0)
-    shape.size = size
+    shape.size = fitted_size(shape.size, extent)
     shape.geom = Solid(mesh_id, member)
     return False
+
+
+def fitted_size(size, extent) -> list[float]:
+    """The scope size an inserted mesh of size ``extent`` takes (LANGUAGE.md section 5, CGA).
+
+    Zero scope sizes are filled in: all three zero keep the mesh's own size, two zero scale it
+    uniformly by the non-zero axis, one zero takes that axis from the mean of the other two
+    scale factors.  An axis along which the mesh itself is flat stays as the scope has it.
+    """
+    size = list(size)
+    zero = [s <= 1e-12 and e > 0 for s, e in zip(size, extent, strict=True)]
+    if not any(zero):
+        return size
+    if all(s <= 1e-12 for s in size):
+        return list(extent)
+    factors = [size[i] / extent[i] for i in range(3) if not zero[i] and extent[i] > 0]
+    factor = sum(factors) / len(factors) if factors else 1.0
+    return [extent[i] * factor if zero[i] else size[i] for i in range(3)]
 
 
 def _load_asset(app, step, module, asset):
