@@ -50,7 +50,7 @@ _SYMBOL_KINDS = {
     FOOTPRINT_KIND: FOOTPRINT_KINDS,
     EXTRUDE_KIND: EXTRUDE_KINDS,
 }
-_RESERVED_ALIASES = {"scope", "split", "comp", "stdlib"}
+_RESERVED_ALIASES = {"scope", "split", "comp", "stdlib", "geometry"}
 
 
 @dataclass

@@ -259,6 +259,15 @@ BUILTINS: dict[str, Builtin] = {
         Builtin("cos", 1, 1, "cos(deg)", "cosine of an angle in degrees."),
         Builtin("tan", 1, 1, "tan(deg)", "tangent of an angle in degrees."),
         Builtin("clamp", 3, 3, "clamp(x, lo, hi)", "x limited to the range lo..hi."),
+        Builtin(
+            "geometry.isRectangular",
+            0,
+            1,
+            "geometry.isRectangular(tolerance)",
+            "true when the shape's outline (a 2D shape's, or an extruded prism's base) is one "
+            "rectangle without holes, every corner within tolerance degrees of a right angle "
+            "(default 1), as CGA's function of that name; false for other solids but cubes.",
+        ),
     ]
 }
 

@@ -287,6 +287,9 @@ class Compiler:
                 max(_num(module, pos, x(ctx)), _num(module, pos, lo(ctx))),
                 _num(module, pos, hi(ctx)),
             )
+        if name == "geometry.isRectangular":
+            tolerance = args[0] if args else (lambda ctx: 1.0)
+            return lambda ctx: is_rectangular(ctx.shape, _num(module, pos, tolerance(ctx)))
         if name in _MATH:
             fn, (a,) = _MATH[name], args
 
@@ -374,3 +377,18 @@ def evaluate_values(
     for name in pending:
         get(name)
     return values
+
+
+def is_rectangular(shape, tolerance: float) -> bool:
+    """geometry.isRectangular of a shape: its 2D outline, or an extruded prism's base."""
+    from .geometry.meshes import PLANE_AXES
+    from .geometry.polygons import is_rectangle
+    from .shapes import Flat, Prism, Solid
+
+    geom = shape.geom
+    if isinstance(geom, Solid):
+        return geom.name == "cube"
+    if isinstance(geom, (Flat, Prism)):
+        p, q = PLANE_AXES[geom.k]
+        return is_rectangle(geom.polys, shape.size[p], shape.size[q], tolerance)
+    return False

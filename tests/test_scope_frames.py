@@ -199,3 +199,60 @@ def test_a_primitive_keeps_a_scope_with_no_zero_size():
     assert q["size"] == pytest.approx([2.0, 2.0, 2.0])  # two zero: uniform by the third
     (r,) = terminals("Lot --> s(0, 0, 0) i(quad) P\nterminal P\n")
     assert r["size"] == pytest.approx([1.0, 1.0, 0.0])  # all zero: the primitive's own size
+
+
+# ---- geometry.isRectangular and the ridge trims (issue 9, visible defects) -------------------
+
+RIDGE = """\
+import stdlib.roof as rf
+Lot --> extrude(6) comp(f) { top: rf.RidgeGable(chimney = true) | all: NIL }
+"""
+
+
+def _trapezoid(tmp_path):
+    path = tmp_path / "trapezoid.geojson"
+    ring = [[38, 2], [52, 0], [54, 14], [38, 14], [38, 2]]
+    feature = {
+        "type": "Feature",
+        "properties": {},
+        "geometry": {"type": "Polygon", "coordinates": [ring]},
+    }
+    path.write_text(json.dumps({"type": "FeatureCollection", "features": [feature]}))
+    return str(path)
+
+
+@pytest.mark.parametrize(
+    "lot, expected",
+    [((10, 8), "A"), ("trapezoid", "B"), ("l_lot", "B")],
+)
+def test_geometry_is_rectangular(tmp_path, lot, expected):
+    from pathlib import Path
+
+    if lot == "trapezoid":
+        lot = _trapezoid(tmp_path)
+    elif lot == "l_lot":
+        lot = str(Path(__file__).resolve().parents[1] / "examples" / "l_lot.geojson")
+    src = "Lot --> case geometry.isRectangular(1): A | else: B\nterminal A, B\n"
+    assert [t["label"] for t in terminals(src, lot=lot)] == [expected]
+
+
+def test_ridge_trims_sit_on_the_roof_of_a_rectangle():
+    result = bgr.derive(bgr.load(RIDGE), lot=(12, 8))
+    table = result.terminals
+    roof_rows = [i for i, lab in enumerate(table.label) if lab == "Roof"]
+    ridge_rows = [i for i, lab in enumerate(table.label) if lab == "Ridge"]
+    assert roof_rows and ridge_rows
+    mesh = result.mesh
+    roof_top = 6 + 4 * np.tan(np.radians(40))  # the ridge of a 40-degree gable over 8 m
+    ys = mesh.vertices[:, 1]
+    # the highest vertex is the chimney's; the ridge cap straddles the ridge line: some of its
+    # vertices below the ridge height, some above, none more than 0.3 m away
+    cap = [t for t in terminals(RIDGE, lot=(12, 8)) if t["label"] == "Ridge"][0]
+    lo, hi = box(cap)
+    assert lo[1] < roof_top < hi[1] and hi[1] - roof_top < 0.3
+    assert ys.max() > roof_top  # the chimney rises above the ridge
+
+
+def test_ridge_trims_give_way_to_a_plain_gable_off_the_rectangle(tmp_path):
+    labels = {t["label"] for t in terminals(RIDGE, lot=_trapezoid(tmp_path))}
+    assert "Roof" in labels and not labels & {"Ridge", "Eave", "Chimney"}

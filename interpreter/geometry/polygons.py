@@ -8,6 +8,8 @@ every such terminal shares one instanced mesh.
 
 from __future__ import annotations
 
+import math
+
 import mapbox_earcut
 import numpy as np
 import shapely
@@ -179,3 +181,34 @@ def named_footprint(kind: str, a: float, b: float) -> list[Poly]:
     else:
         raise ValueError(f"unknown footprint {kind!r}")
     return [(tuple((float(u), float(v)) for u, v in ring), ())]
+
+
+def is_rectangle(polys, su: float, sv: float, tolerance_deg: float = 1.0) -> bool:
+    """Is the outline one rectangle without holes (CGA's ``geometry.isRectangular``)?
+
+    ``polys`` are unit polygons (or RECT) of a scope ``su`` x ``sv`` metres.  Vertices where
+    the outline runs on straight (within the tolerance) are ignored, so a rectangle with an
+    extra point on an edge still counts; every remaining corner must be within
+    ``tolerance_deg`` of a right angle, and there must be four of them.
+    """
+    if polys == RECT:
+        return True
+    if len(polys) != 1 or polys[0][1]:
+        return False
+    ring = metric(polys, su, sv)[0][0]
+    n = len(ring)
+    corners = 0
+    for i in range(n):
+        (ax, ay), (bx, by), (cx, cy) = ring[i - 1], ring[i], ring[(i + 1) % n]
+        d1, d2 = (bx - ax, by - ay), (cx - bx, cy - by)
+        if math.hypot(*d1) < 1e-12 or math.hypot(*d2) < 1e-12:
+            continue  # a repeated point
+        turn = math.degrees(
+            math.atan2(d1[0] * d2[1] - d1[1] * d2[0], d1[0] * d2[0] + d1[1] * d2[1])
+        )
+        if abs(turn) <= tolerance_deg:
+            continue  # straight on
+        if abs(abs(turn) - 90.0) > tolerance_deg:
+            return False
+        corners += 1
+    return corners == 4
