@@ -316,3 +316,46 @@ def test_a_grammar_that_does_not_derive_is_a_bgr_error(monkeypatch):
     monkeypatch.setattr(derive_module, "derive", broken)
     with pytest.raises(bgr.BgrError, match="ValueError: a ring of three points"):
         infer(src)
+
+
+# ---- frames, not axis conventions ------------------------------------------------------------
+
+FRAMED = """\
+terminal Wall, Glass, Frame, Sill
+Lot --> s(12, 0, 8) extrude(6) comp(f) { front: F | side: Wall | top: NIL | bottom: NIL }
+F --> split(y) { { ~3: Floor }* }
+Floor --> split(x) { ~1: Wall | { 1.2: Win | ~1.5: Wall }* }
+Win --> split(y) { ~1: Wall | 0.08: s('1, '1, 0.2) i(cube) Sill | 1.6: W | ~0.4: Wall }
+W --> offset(0.06) { border: extrude(0.08) Frame | inside: t(0, 0, -0.15) Glass }
+"""
+
+
+def _extruded_the_cga_way(data: dict) -> dict:
+    """The same terminal list with every extruded part (a prism) in CGA's extrude frame: y along
+    the extrusion, x kept, z completing the right-handed frame.  The boxes are unchanged."""
+    out = json.loads(json.dumps(data))
+    for t in out["terminals"]:
+        if t["geometry"] != "prism":
+            continue
+        (x, y, z), (sx, sy, sz) = t["axes"], t["size"]
+        t["axes"] = [x, z, [-v for v in y]]
+        t["size"] = [sx, sz, sy]
+        t["origin"] = [o + sy * v for o, v in zip(t["origin"], y, strict=True)]
+    return out
+
+
+def test_schemas_do_not_depend_on_how_extrude_sets_the_scope():
+    """Frames extruded from a wall belong to it whether their depth is along their z (the
+    interpreter today) or along their y (CGA's extrude): the reader reads each terminal's own
+    frame, so both terminal lists give the same grammar."""
+    buffer = io.StringIO()
+    write_json(bgr.derive(bgr.load(FRAMED)).terminals, buffer, seed=0, attrs={})
+    data = json.loads(buffer.getvalue())
+    turned = _extruded_the_cga_way(data)
+    assert any(t["geometry"] == "prism" for t in data["terminals"])
+    assert turned != data
+    text = bgr.format_module(infer(data))
+    assert bgr.format_module(infer(turned)) == text
+    # the frame (and the glass it overlaps, one part) sits in the wall's window column
+    assert "Win --> split(y) { ~0.942857143: Wall | ~0.08: Sill | ~1.6: W |" in text
+    assert read_model(turned).dropped == 0

@@ -174,22 +174,36 @@ def _same_axes(a, b) -> bool:
 DEPTH = 1.0  # metres: recessed glass and extruded frames within this of the wall belong to its face
 
 
-def _same_plane(t: _Terminal, first: _Terminal) -> bool:
-    """Whether ``t`` lies in ``first``'s face: the same axes, flat along the same one, and within
-    DEPTH of its plane (a recess or a frame is projected onto the face; its depth is not part
-    of the schema)."""
-    normal = first.normal
-    return (
-        t.k == first.k
-        and _same_axes(t.axes, first.axes)
-        and abs(_dot(t.origin, normal) - _dot(first.origin, normal)) < DEPTH
-    )
+def _same_plane(t: _Terminal, ref: _Terminal) -> bool:
+    """Whether ``t`` lies in ``ref``'s face, within DEPTH of its plane (a recess or a frame is
+    projected onto the face; its depth is not part of the schema).
+
+    Two flat terminals (or two solids) must have the same axes and be flat along the same one.
+    A solid beside a flat terminal only needs one of its axes along the face's normal, whichever
+    it is: a frame extruded from a wall has its depth along z or along y depending on how
+    extrude() sets the scope, and it belongs to the wall either way."""
+    if t.flat == ref.flat:
+        if t.k != ref.k or not _same_axes(t.axes, ref.axes):
+            return False
+        normal = ref.normal
+    else:
+        normal = (ref if ref.flat else t).normal
+        solid = t if ref.flat else ref
+        if not any(abs(abs(_dot(a, normal)) - 1.0) < 1e-6 for a in solid.axes):
+            return False
+    return abs(_dot(t.origin, normal) - _dot(ref.origin, normal)) < DEPTH
+
+
+def _reference(terminals: list[_Terminal]) -> _Terminal:
+    """The terminal whose plane a group of terminals is read in: the first flat one (a face's
+    own surface), else the first."""
+    return next((t for t in terminals if t.flat), terminals[0])
 
 
 def _coplanar(terminals: list[_Terminal]) -> bool:
-    """One face: every terminal in the first one's plane."""
-    first = terminals[0]
-    return all(_same_plane(t, first) for t in terminals)
+    """One face: every terminal in the reference's plane."""
+    ref = _reference(terminals)
+    return all(_same_plane(t, ref) for t in terminals)
 
 
 def _area(t: _Terminal) -> float:
@@ -207,9 +221,12 @@ def _main_plane(terminals: list[_Terminal]) -> set[int] | None:
     A window with 3D parts puts small terminals at right angles to the wall (the sides of its
     reveal, the top of its sill); they belong to the face they are set in, not to faces of
     their own.  The subtree is one face when the terminals in its largest plane (same axes,
-    within DEPTH) outweigh all the others by area; the others are left out of the schema."""
+    within DEPTH) outweigh all the others by area; the others are left out of the schema.
+    Planes are set by flat terminals; a solid joins the first plane it stands in (it could
+    stand in three: a box has an axis along each), else solids group among themselves."""
     groups: list[tuple[_Terminal, list[_Terminal]]] = []
-    for t in terminals:
+    ordered = [t for t in terminals if t.flat] + [t for t in terminals if not t.flat]
+    for t in ordered:
         for first, members in groups:
             if _same_plane(t, first):
                 members.append(t)
@@ -252,7 +269,7 @@ def _face_nodes(node: _Node, out: list) -> None:
             continue
         if not terms or not any(t.flat for t in terms):  # a solid (a roof, a box), no face
             continue
-        first = terms[0]
+        first = _reference(terms)
         key = tuple(round(v, 5) for v in first.normal) + (
             round(_dot(first.origin, first.normal), 5),
         )
@@ -576,7 +593,7 @@ def _read_face(group: _Node, kept: set[int], fixed: dict[str, bool], frames: dic
     give: x and y along the two axes of their plane.  None for a face without area (zero width
     or height): nothing to subdivide, and a grammar cannot re-create it."""
     terms = [t for t in group.terminals if t.index in kept]
-    first = terms[0]
+    first = _reference(terms)
     p, q = first.plane
     x, y = first.axes[p], first.axes[q]
     u0, v0, u1, v1 = _union([_Frame(first.origin, x, y).rect(t) for t in terms])
