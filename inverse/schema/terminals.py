@@ -37,9 +37,9 @@ class _Terminal:
     ``k`` is the scope axis the terminal is flat along (its size there is 0), so its plane is
     spanned by the other two axes in index order: a face from comp(f) is flat along z (plane x,
     y), a piece of a lot along y (plane x, z).  Nothing assumes which axis is up.  A solid (no
-    size 0) counts as flat along its z: a frame or a recessed pane is projected along its depth
-    onto the face it is set in.  ``k`` is None when two or three sizes are 0 (a line or a point,
-    which has no area to subdivide).
+    size 0) has ``k`` 2 for when it stands alone, but beside flat terminals it joins the face
+    one of its axes is normal to (:func:`_same_plane`).  ``k`` is None when two or three sizes
+    are 0 (a line or a point, which has no area to subdivide).
     """
 
     index: int
