@@ -588,7 +588,9 @@ def link_faces(faces: list[Face]) -> list[list[Face]]:
     return blocks
 
 
-def _read_face(group: _Node, kept: set[int], fixed: dict[str, bool], frames: dict):
+def _read_face(
+    group: _Node, kept: set[int], fixed: dict[str, bool], frames: dict
+) -> tuple[Face, _Terminal] | None:
     """One face of the rule tree as a Face (and its first terminal), in the frame its terminals
     give: x and y along the two axes of their plane.  None for a face without area (zero width
     or height): nothing to subdivide, and a grammar cannot re-create it."""
@@ -638,11 +640,12 @@ def model_from_terminals(
         raise _error(path, "the terminal list is empty: nothing to infer from")
     terminals = [t for t in every if t.k is not None]
     skipped = len(every) - len(terminals)
+    fixed = dict(fixed or {})
     found: list = []
     _face_nodes(_tree(terminals), found)
     vertical, horizontal = [], []
     for group, kept in found:
-        read = _read_face(group, kept, dict(fixed or {}), frames)
+        read = _read_face(group, kept, fixed, frames)
         if read is None:
             skipped += 1
             continue
