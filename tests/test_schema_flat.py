@@ -13,13 +13,13 @@ import json
 
 import numpy as np
 import pytest
-from bgr.interpreter.writers import write_json
-from bgr.inverse.schema import check_derives, infer, read_model, source_lot
-from bgr.inverse.schema import faces as fs
 from conftest import ROOT
 
 import bgr
 from bgr.cli import main
+from bgr.interpreter.writers import write_json
+from bgr.inverse.schema import check_derives, infer, read_model, source_lot
+from bgr.inverse.schema import faces as fs
 
 DATA = ROOT / "tests" / "data" / "schema"
 # (a) bays with fixed trims, (b) shop fronts, (c) floors of bays; trims are fixed by --fixed
@@ -330,9 +330,10 @@ W --> offset(0.06) { border: extrude(0.08) Frame | inside: t(0, 0, -0.15) Glass 
 """
 
 
-def _extruded_the_cga_way(data: dict) -> dict:
-    """The same terminal list with every extruded part (a prism) in CGA's extrude frame: y along
-    the extrusion, x kept, z completing the right-handed frame.  The boxes are unchanged."""
+def _depth_turned(data: dict) -> dict:
+    """The same terminal list with every extruded part (a prism) in the other extrude frame:
+    x kept, the depth moved from y to z (CGA's extrude, the interpreter's since it follows CGA,
+    puts it along y; the interpreter before put it along z), the boxes unchanged."""
     out = json.loads(json.dumps(data))
     for t in out["terminals"]:
         if t["geometry"] != "prism":
@@ -345,13 +346,13 @@ def _extruded_the_cga_way(data: dict) -> dict:
 
 
 def test_schemas_do_not_depend_on_how_extrude_sets_the_scope():
-    """Frames extruded from a wall belong to it whether their depth is along their z (the
-    interpreter today) or along their y (CGA's extrude): the reader reads each terminal's own
-    frame, so both terminal lists give the same grammar."""
+    """Frames extruded from a wall belong to it whether their depth is along their y (CGA's
+    extrude) or along their z (how the interpreter extruded before): the reader reads each
+    terminal's own frame, so both terminal lists give the same grammar."""
     buffer = io.StringIO()
     write_json(bgr.derive(bgr.load(FRAMED)).terminals, buffer, seed=0, attrs={})
     data = json.loads(buffer.getvalue())
-    turned = _extruded_the_cga_way(data)
+    turned = _depth_turned(data)
     assert any(t["geometry"] == "prism" for t in data["terminals"])
     assert turned != data
     text = bgr.format_module(infer(data))
