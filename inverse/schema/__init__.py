@@ -21,7 +21,7 @@ from bgr.grammar.errors import BgrError, Diagnostic
 
 from .model import Model
 
-__all__ = ["Model", "infer", "read_model"]
+__all__ = ["Model", "check_derives", "infer", "read_model", "source_lot"]
 
 
 def read_model(source, *, fixed: dict[str, bool] | None = None, seed: int = 0, lot=None) -> Model:
@@ -88,7 +88,44 @@ def _from_dict(data, shown: str, fixed) -> Model:
 
 
 def infer(source, *, fixed: dict[str, bool] | None = None, seed: int = 0, lot=None) -> n.Module:
-    """The style grammar of ``source`` (see :func:`read_model`) as a syntax tree."""
+    """The style grammar of ``source`` (see :func:`read_model`) as a syntax tree.
+
+    The grammar is derived once on the source's own size before it is returned (see
+    :func:`check_derives`): a grammar that cannot derive is never handed out to be written."""
     from .emit import Emitter
 
-    return Emitter(read_model(source, fixed=fixed, seed=seed, lot=lot)).module()
+    model = read_model(source, fixed=fixed, seed=seed, lot=lot)
+    module = Emitter(model).module()
+    check_derives(module, model)
+    return module
+
+
+def source_lot(model: Model) -> tuple[float, float]:
+    """The rectangle lot (width, depth) that re-creates the model's basis block: its extent in
+    plan, or for a flat model the façade's own width and height; 20 m where a side is 0 (a lone
+    face has no depth)."""
+    block = model.sorted_blocks()[0]
+    return tuple(v if v > 1e-6 else 20.0 for v in (block.width, block.depth))
+
+
+def check_derives(module: n.Module, model: Model) -> None:
+    """Derive the inferred grammar on the source's size; a grammar that does not check or
+    derive (an error, or a failure inside the geometry code) is a bug of the inference, and
+    becomes one BgrError naming the source rather than a file that fails later."""
+    from bgr.grammar.formatter import format_module
+    from bgr.grammar.loader import load
+    from bgr.interpreter.derive import derive
+
+    try:
+        derive(load(format_module(module), path="<inferred>"), lot=source_lot(model))
+    except Exception as exc:  # any failure at all: such a grammar must not be written
+        detail = exc.message if isinstance(exc, BgrError) else f"{type(exc).__name__}: {exc}"
+        raise BgrError(
+            Diagnostic(
+                model.source or "<model>",
+                0,
+                0,
+                f"the inferred grammar does not derive on the source's size: {detail}",
+                "nothing was written; this is a bug in bgr infer, please report it with the input",
+            )
+        ) from None

@@ -70,6 +70,10 @@ class Emitter:
                     self.labels.append(leaf.label)
         self.labels += [lbl for lbl in model.roof_labels if lbl not in self.labels]
         self.taken.update({"Lot"})
+        # the scope axes a face's columns (x) and rows (y) are split along: a face from comp(f)
+        # has x across and y up; a flat façade is the lot, whose rows run along another axis
+        x_name, y_name = model.flat_axes or ("x", "y")
+        self.axis_names = {"x": x_name, "y": y_name}
         # a label that is a plain name is a terminal of that name; any other ("shop-window",
         # "Lot", "split") gets a rule of a clean name that sets the label
         self.leaf: dict[str, str] = {}
@@ -143,7 +147,7 @@ class Emitter:
         entries = self.entries(items, parts)
         if not _reproduces(entries, parts, sum(p.size for p in parts)):
             entries = [self.entry(p) for p in parts]  # written out: exact, but it will not grow
-        return n.Operation("split", [n.Name(cell.axis)], n.Block(entries))
+        return n.Operation("split", [n.Name(self.axis_names[cell.axis])], n.Block(entries))
 
     def entries(self, items, parts: list[Cell]) -> list:
         out = []
@@ -189,38 +193,45 @@ class Emitter:
     def by_width(self, ranked: list[tuple[Face, str]]) -> str:
         """A rule choosing by width among equally good faces (closest width, then fewest
         occluded subfaces), or the one face's schema."""
-        names = []
-        for face, name in ranked:
-            if name not in [nm for _, nm in names]:
-                names.append((face, name))
+        names = _distinct(ranked)
         if len(names) == 1:
             return names[0][1]
         key = "|".join(f"{nm}@{round(f.width, 4)}" for f, nm in names)
         if key in self.by_key:
             return self.by_key[key]
-        # among schemas of the same width, the one with the fewest occluded subfaces
+        body = self.width_choice(names)
+        if isinstance(body, n.Sequence):
+            return body.steps[0].name
+        rule_name = self.by_key[key] = self.fresh("ByWidth")
+        self.rules.append(n.Rule(rule_name, [], body))
+        return rule_name
+
+    def width_choice(self, ranked: list[tuple[Face, str]]) -> n.Sequence | n.Conditional:
+        """The body that picks the schema of the closest width (``case scope.sx < mid: ...``),
+        among schemas of the same width the one with the fewest occluded subfaces; the one
+        schema's successor when there is nothing to choose."""
         widths = []
-        for face, name in sorted(names, key=lambda fn: (fn[0].width, fn[0].occluded())):
+        for face, name in sorted(_distinct(ranked), key=lambda fn: (fn[0].width, fn[0].occluded())):
             if not widths or face.width - widths[-1][0].width > 1e-6:
                 widths.append((face, name))
         if len(widths) == 1:
-            return widths[0][1]
+            return n.Sequence([n.Successor(widths[0][1])])
+        measure = n.Name("scope.s" + self.axis_names["x"])
         cases = []
         for (a, name), (b, _) in itertools.pairwise(widths):
             mid = (a.width + b.width) / 2
             cases.append(
                 n.Case(
-                    n.Binary("<", n.Name("scope.sx"), n.Number(_clean(mid))),
-                    n.Sequence([n.Successor(name)]),
+                    n.Binary("<", measure, n.Number(_clean(mid))), n.Sequence([n.Successor(name)])
                 )
             )
         cases.append(n.Case(None, n.Sequence([n.Successor(widths[-1][1])])))
-        rule_name = self.by_key[key] = self.fresh("ByWidth")
-        self.rules.append(n.Rule(rule_name, [], _body(_merge(cases))))
-        return rule_name
+        return _body(_merge(cases))
 
     # ---- the whole grammar ---------------------------------------------------------------
     def module(self) -> n.Module:
+        if self.model.flat_axes is not None:
+            return self.flat_module()
         basis = self.model.sorted_blocks()[0]
         by_side = self.face_rules()
         choosers = {s: self.chooser(s, by_side) for s in SIDES}
@@ -266,7 +277,63 @@ class Emitter:
                 f"# ({self.model.dropped} small faces on no mass, such as the sides of "
                 "bays and dormers, are left out.)",
             )
+        header += self.skipped_note()
         return _laid_out(header, [head, [lot], list(choosers.values()), self.rules, self.colored])
+
+    def flat_module(self) -> n.Module:
+        """The grammar of a flat model: the lot is the façade.  No extrude, no comp and no
+        height: the lot rule splits the lot itself (its floors along the lot's axis that the
+        source's rows ran along, ``split(z)`` for a lot split in x and z), and the lot's size is
+        the façade's width and height.  Several distinct façades (one per lot of a GeoJSON
+        source) are chosen among by width."""
+        faces = self.model.faces()
+        keys = list(dict.fromkeys(f.root.key() for f in faces))
+        if len(keys) == 1:
+            root = faces[0].root
+            if root.is_leaf:
+                body = self.target(root)
+            else:
+                self.by_key[root.key()] = "Lot"
+                body = n.Sequence([self.split(root, floors=True)])
+        else:
+            body = self.width_choice([(f, self.flat_schema(f)) for f in faces])
+        lot = n.Rule("Lot", [], body)
+        head: list = [n.Version(1)]
+        if self.terminals:
+            head.append(n.TerminalDecl(list(self.terminals)))
+        leaves = sum(f.root.count() for f in faces)
+        x_name, y_name = self.axis_names["x"], self.axis_names["y"]
+        plural = "s" if len(faces) != 1 else ""
+        header = [
+            f"# Inferred by bgr infer --kind schema from {self.model.source or 'a model'}:",
+            f"# {len(faces)} flat façade{plural}, {leaves} subfaces; {len(self.rules) + 1} schema "
+            "rules. The lot is the façade:",
+            f"# its columns run along the lot's {x_name}, its rows (floors) along its {y_name}. "
+            "Derive it on a lot",
+            "# as wide and as high as the façade:",
+            "#   bgr derive THIS.bgr --lot W,H|LOTS.geojson -o out.glb",
+        ]
+        header += self.skipped_note()
+        return _laid_out(header, [head, [lot], self.rules, self.colored])
+
+    def flat_schema(self, face: Face) -> str:
+        """The rule of one flat façade among several."""
+        if not face.root.is_leaf:
+            return self.rule_for(face.root, face.name)
+        name = self.by_key.get(face.root.key())
+        if name is None:
+            name = self.by_key[face.root.key()] = self.fresh(face.name)
+            self.rules.append(n.Rule(name, [], self.target(face.root)))
+        return name
+
+    def skipped_note(self) -> list[str]:
+        if not self.model.skipped:
+            return []
+        count = self.model.skipped
+        return [
+            f"# ({count} part{'s' if count != 1 else ''} of zero size (lines, faces without "
+            f"area) {'are' if count != 1 else 'is'} left out.)"
+        ]
 
 
 # ---- symbol strings ----------------------------------------------------------------------------
@@ -397,6 +464,14 @@ def _reproduces(entries, parts: list[Cell], length: float) -> bool:
 
 
 # ---- floor-schema choice -------------------------------------------------------------------
+
+
+def _distinct(ranked: list[tuple[Face, str]]) -> list[tuple[Face, str]]:
+    """The first face of each schema name, in order."""
+    out: dict[str, Face] = {}
+    for face, name in ranked:
+        out.setdefault(name, face)
+    return [(face, name) for name, face in out.items()]
 
 
 def _corner_test(name: str, kind: str):

@@ -81,6 +81,11 @@ class Face:
     name: str = "Face"
     origin: tuple[float, float, float] = (0.0, 0.0, 0.0)
     x_axis: tuple[float, float, float] = (1.0, 0.0, 0.0)
+    y_axis: tuple[float, float, float] = (
+        0.0,
+        1.0,
+        0.0,
+    )  # up the face (of a flat face: the lot's z)
     normal: tuple[float, float, float] = (0.0, 0.0, -1.0)
     order: int = 0  # position in the source's derivation order (the order its terminals came out)
     lot: str = ""  # the lot (building) it belongs to: faces of different lots never link
@@ -120,6 +125,12 @@ class Model:
     roof_labels: list[str] = field(default_factory=list)  # labels found on horizontal faces
     label_colors: dict[str, str] = field(default_factory=dict)  # "#rrggbb" per label, when known
     dropped: int = 0  # faces on no mass (parts at odd angles) left out of the schemas
+    skipped: int = 0  # parts without area (a line, a face of zero height) left out
+    # A flat model: its faces lie flat on their lots (a façade derived on the lot rectangle, with
+    # no extrude), and the grammar splits the lot itself.  The names of the lot's scope axes
+    # that a face's x (its width) and y (its height) run along, e.g. ("x", "z"); None for a
+    # model of masses, whose faces come from comp(f).
+    flat_axes: tuple[str, str] | None = None
 
     def faces(self) -> list[Face]:
         return [f for b in self.blocks for f in b.faces]

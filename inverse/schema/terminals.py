@@ -32,6 +32,16 @@ _HEX = re.compile(r"#[0-9a-fA-F]{6}")
 
 @dataclass
 class _Terminal:
+    """One terminal of the list, with the plane it lies in read from its own frame.
+
+    ``k`` is the scope axis the terminal is flat along (its size there is 0), so its plane is
+    spanned by the other two axes in index order: a face from comp(f) is flat along z (plane x,
+    y), a piece of a lot along y (plane x, z).  Nothing assumes which axis is up.  A solid (no
+    size 0) has ``k`` 2 for when it stands alone, but beside flat terminals it joins the face
+    one of its axes is normal to (:func:`_same_plane`).  ``k`` is None when two or three sizes
+    are 0 (a line or a point, which has no area to subdivide).
+    """
+
     index: int
     label: str
     path: str
@@ -39,6 +49,25 @@ class _Terminal:
     axes: tuple[tuple[float, float, float], ...]
     size: tuple[float, float, float]
     color: str | None = None
+    k: int | None = field(init=False, default=2)
+    flat: bool = field(init=False, default=False)
+
+    def __post_init__(self) -> None:
+        zeros = [i for i in range(3) if self.size[i] < TOL]
+        self.flat = len(zeros) == 1
+        self.k = zeros[0] if self.flat else (2 if not zeros else None)
+
+    @property
+    def normal(self) -> tuple[float, float, float]:
+        return self.axes[self.k]
+
+    @property
+    def plane(self) -> tuple[int, int]:
+        """The indices of the two scope axes the terminal's plane is spanned by, in order."""
+        return _PLANES[self.k]
+
+
+_PLANES = {0: (1, 2), 1: (0, 2), 2: (0, 1)}
 
 
 @dataclass
@@ -142,23 +171,44 @@ def _same_axes(a, b) -> bool:
     return all(abs(a[i][j] - b[i][j]) < 1e-6 for i in range(3) for j in range(3))
 
 
-def _flat(t: _Terminal) -> bool:
-    return t.size[2] < TOL
-
-
 DEPTH = 1.0  # metres: recessed glass and extruded frames within this of the wall belong to its face
 
 
+def _same_plane(t: _Terminal, ref: _Terminal) -> bool:
+    """Whether ``t`` lies in ``ref``'s face, within DEPTH of its plane (a recess or a frame is
+    projected onto the face; its depth is not part of the schema).
+
+    Two flat terminals (or two solids) must have the same axes and be flat along the same one.
+    A solid beside a flat terminal only needs one of its axes along the face's normal, whichever
+    it is: a frame extruded from a wall has its depth along z or along y depending on how
+    extrude() sets the scope, and it belongs to the wall either way."""
+    if t.flat == ref.flat:
+        if t.k != ref.k or not _same_axes(t.axes, ref.axes):
+            return False
+        normal = ref.normal
+    else:
+        normal = (ref if ref.flat else t).normal
+        solid = t if ref.flat else ref
+        if not any(abs(abs(_dot(a, normal)) - 1.0) < 1e-6 for a in solid.axes):
+            return False
+    return abs(_dot(t.origin, normal) - _dot(ref.origin, normal)) < DEPTH
+
+
+def _reference(terminals: list[_Terminal]) -> _Terminal:
+    """The terminal whose plane a group of terminals is read in: the first flat one (a face's
+    own surface), else the first."""
+    return next((t for t in terminals if t.flat), terminals[0])
+
+
 def _coplanar(terminals: list[_Terminal]) -> bool:
-    """One face: the same axes, and all within DEPTH of one plane (a recess or a frame is
-    projected onto the face; its depth is not part of the schema)."""
-    first = terminals[0]
-    normal = first.axes[2]
-    plane = _dot(first.origin, normal)
-    return all(
-        _same_axes(t.axes, first.axes) and abs(_dot(t.origin, normal) - plane) < DEPTH
-        for t in terminals
-    )
+    """One face: every terminal in the reference's plane."""
+    ref = _reference(terminals)
+    return all(_same_plane(t, ref) for t in terminals)
+
+
+def _area(t: _Terminal) -> float:
+    p, q = t.plane
+    return t.size[p] * t.size[q]
 
 
 LINK = 0.6  # metres: face corners this close are one corner
@@ -171,21 +221,21 @@ def _main_plane(terminals: list[_Terminal]) -> set[int] | None:
     A window with 3D parts puts small terminals at right angles to the wall (the sides of its
     reveal, the top of its sill); they belong to the face they are set in, not to faces of
     their own.  The subtree is one face when the terminals in its largest plane (same axes,
-    within DEPTH) outweigh all the others by area; the others are left out of the schema."""
+    within DEPTH) outweigh all the others by area; the others are left out of the schema.
+    Planes are set by flat terminals; a solid joins the first plane it stands in (it could
+    stand in three: a box has an axis along each), else solids group among themselves."""
     groups: list[tuple[_Terminal, list[_Terminal]]] = []
-    for t in terminals:
+    ordered = [t for t in terminals if t.flat] + [t for t in terminals if not t.flat]
+    for t in ordered:
         for first, members in groups:
-            if (
-                _same_axes(t.axes, first.axes)
-                and abs(_dot(t.origin, first.axes[2]) - _dot(first.origin, first.axes[2])) < DEPTH
-            ):
+            if _same_plane(t, first):
                 members.append(t)
                 break
         else:
             groups.append((t, [t]))
         if len(groups) > 64:  # many orientations: a whole mass, not one face
             return None
-    areas = [sum(t.size[0] * t.size[1] for t in members) for _, members in groups]
+    areas = [sum(_area(t) for t in members) for _, members in groups]
     best = max(range(len(groups)), key=lambda i: areas[i])
     if sum(areas) - areas[best] > MINOR * areas[best]:
         return None
@@ -196,8 +246,13 @@ def _face_nodes(node: _Node, out: list) -> None:
     """Collect (node, kept terminal indices) per face: the highest subtrees that lie in one
     plane, up to minor parts at other angles.  Where a rule's children are the pieces of a face
     with no rule of its own (``comp(f) { front: split(x) { ... } }``), the children in one plane
-    are gathered into one face."""
-    if node.terminals and node.path:
+    are gathered into one face.  Lots are never gathered: two flat lots side by side lie in one
+    plane, but each is a façade of its own."""
+    if not node.path:  # the root: one subtree per lot
+        for item in node.items:
+            _face_nodes(item, out)
+        return
+    if node.terminals:
         kept = (
             {t.index for t in node.terminals}
             if _coplanar(node.terminals)
@@ -212,11 +267,11 @@ def _face_nodes(node: _Node, out: list) -> None:
         if isinstance(item, _Node) and not (terms and _coplanar(terms)):
             _face_nodes(item, out)
             continue
-        if not terms or not any(_flat(t) for t in terms):  # a solid (a roof, a box), no face
+        if not terms or not any(t.flat for t in terms):  # a solid (a roof, a box), no face
             continue
-        first = terms[0]
-        key = tuple(round(v, 5) for v in first.axes[2]) + (
-            round(_dot(first.origin, first.axes[2]), 5),
+        first = _reference(terms)
+        key = tuple(round(v, 5) for v in first.normal) + (
+            round(_dot(first.origin, first.normal), 5),
         )
         if key not in planes:
             planes[key] = _Node(node.path, gathered=True)
@@ -235,18 +290,38 @@ def _face_nodes(node: _Node, out: list) -> None:
 
 @dataclass
 class _Frame:
+    """A face's frame: its bottom left corner and the directions of its width (x) and height (y)
+    in the world, from the terminals' own frames (never from a guess at which axis is up)."""
+
     origin: tuple[float, float, float]
     x: tuple[float, float, float]
     y: tuple[float, float, float]
+    cache: dict[int, tuple[float, float, float, float]] = field(default_factory=dict)
 
     def rect(self, t: _Terminal) -> tuple[float, float, float, float]:
+        """The terminal's extent in the face, (u0, v0, u1, v1): its scope box projected onto the
+        face's x and y.  Remembered per terminal: every level of the rule tree asks again."""
+        found = self.cache.get(t.index)
+        if found is None:
+            found = self.cache[t.index] = self._project(t)
+        return found
+
+    def _project(self, t: _Terminal) -> tuple[float, float, float, float]:
         d = (
             t.origin[0] - self.origin[0],
             t.origin[1] - self.origin[1],
             t.origin[2] - self.origin[2],
         )
         u, v = _dot(d, self.x), _dot(d, self.y)
-        return (u, v, u + t.size[0], v + t.size[1])
+        p, q = t.plane
+        if t.axes[p] == self.x and t.axes[q] == self.y:  # the face's own axes: exact sizes
+            return (u, v, u + t.size[p], v + t.size[q])
+        u0, u1, v0, v1 = u, u, v, v
+        for axis, length in zip(t.axes, t.size, strict=True):
+            du, dv = _dot(axis, self.x) * length, _dot(axis, self.y) * length
+            u0, u1 = u0 + min(du, 0.0), u1 + max(du, 0.0)
+            v0, v1 = v0 + min(dv, 0.0), v1 + max(dv, 0.0)
+        return (u0, v0, u1, v1)
 
 
 def _union(rects) -> tuple[float, float, float, float]:
@@ -513,59 +588,97 @@ def link_faces(faces: list[Face]) -> list[list[Face]]:
     return blocks
 
 
+def _read_face(
+    group: _Node, kept: set[int], fixed: dict[str, bool], frames: dict
+) -> tuple[Face, _Terminal] | None:
+    """One face of the rule tree as a Face (and its first terminal), in the frame its terminals
+    give: x and y along the two axes of their plane.  None for a face without area (zero width
+    or height): nothing to subdivide, and a grammar cannot re-create it."""
+    terms = [t for t in group.terminals if t.index in kept]
+    first = _reference(terms)
+    p, q = first.plane
+    x, y = first.axes[p], first.axes[q]
+    u0, v0, u1, v1 = _union([_Frame(first.origin, x, y).rect(t) for t in terms])
+    if u1 - u0 < TOL or v1 - v0 < TOL:
+        return None
+    origin = tuple(first.origin[i] + u0 * x[i] + v0 * y[i] for i in range(3))
+    rect = (0.0, 0.0, u1 - u0, v1 - v0)
+    root = _Builder(_Frame(origin, x, y), fixed, kept).cell(group, rect, rect[2])
+    _set_fixed(root, None)
+    lot = first.path.split("/", 1)[0]
+    side = side_of(first.normal, frames.get(lot))
+    if abs(first.normal[1]) > 0.7071 and (group.gathered or "/" not in group.path):
+        name = "Facade"  # lying on the lot: the lot (or the pieces it was cut into) is the façade
+    else:
+        name = side.capitalize() + "Face" if group.gathered else group.name
+    face = Face(
+        rect[2],
+        rect[3],
+        root,
+        name=name,
+        origin=origin,
+        x_axis=x,
+        y_axis=y,
+        normal=first.normal,
+        lot=lot,
+        side=side,
+    )
+    return face, first
+
+
 def model_from_terminals(
     data: dict, path: str = "<terminals>", fixed: dict[str, bool] | None = None
 ) -> Model:
     """The Model of a terminal list: its vertical faces, subdivided, in derivation order, with
-    their corners; horizontal faces' labels are kept for the roof."""
-    terminals = read_terminals(data, path)
+    their corners; horizontal faces' labels are kept for the roof.  A list with no vertical face
+    is a flat model: its faces lie on their lots (a façade derived on the lot rectangle) and are
+    the façades themselves.  Parts without area (lines, points, faces of zero height) are
+    skipped and counted."""
+    every = read_terminals(data, path)
     frames = _lot_frames(data, path)
-    if not terminals:
+    if not every:
         raise _error(path, "the terminal list is empty: nothing to infer from")
+    terminals = [t for t in every if t.k is not None]
+    skipped = len(every) - len(terminals)
     fixed = dict(fixed or {})
     found: list = []
     _face_nodes(_tree(terminals), found)
-    faces, roofs = [], []
+    vertical, horizontal = [], []
     for group, kept in found:
-        terms = [t for t in group.terminals if t.index in kept]
-        first = terms[0]
-        if abs(first.axes[2][1]) > 0.7071:  # a horizontal face: a roof or a floor slab
-            roofs.append(first.label)
+        read = _read_face(group, kept, fixed, frames)
+        if read is None:
+            skipped += 1
             continue
-        probe = _Frame(first.origin, first.axes[0], first.axes[1])
-        rects = [probe.rect(t) for t in terms]
-        u0, v0, u1, v1 = _union(rects)
-        origin = tuple(
-            first.origin[i] + u0 * first.axes[0][i] + v0 * first.axes[1][i] for i in range(3)
-        )
-        frame = _Frame(origin, first.axes[0], first.axes[1])
-        builder = _Builder(frame, fixed, kept)
-        rect = (0.0, 0.0, u1 - u0, v1 - v0)
-        root = builder.cell(group, rect, rect[2])
-        _set_fixed(root, None)
-        lot = first.path.split("/", 1)[0]
-        side = side_of(first.axes[2], frames.get(lot))
-        name = side.capitalize() + "Face" if group.gathered else group.name
-        faces.append(
-            Face(
-                rect[2],
-                rect[3],
-                root,
-                name=name,
-                origin=origin,
-                x_axis=first.axes[0],
-                normal=first.axes[2],
-                order=len(faces),
-                lot=lot,
-                side=side,
-            )
-        )
-    if not faces:
+        kind = horizontal if abs(read[0].normal[1]) > 0.7071 else vertical
+        read[0].order = len(kind)  # derivation order among the faces of its kind
+        kind.append(read)
+    colors: dict[str, str] = {}
+    for t in terminals:  # a label's colour: the first one it comes in
+        if t.color is not None:
+            colors.setdefault(t.label, t.color)
+    if vertical:
+        faces = [face for face, _ in vertical]
+        blocks, dropped = _masses(faces)
+        roofs = [first.label for _, first in horizontal]  # a roof or a floor slab
+        model = Model(blocks, source=path, roof_labels=roofs, label_colors=colors, dropped=dropped)
+    elif horizontal:
+        blocks, axes = _flats(horizontal, frames)
+        model = Model(blocks, source=path, label_colors=colors, flat_axes=axes)
+    else:
         raise _error(
             path,
-            "no vertical faces in the terminal list",
-            "face schemas are inferred from façades: flat terminals on the sides of a mass",
+            "no face with an area in the terminal list"
+            + (f" ({skipped} parts of zero size)" if skipped else ""),
+            "face schemas are inferred from façades: flat terminals on the sides of a mass, "
+            "or on the lot itself",
         )
+    model.skipped = skipped
+    return model
+
+
+def _masses(faces: list[Face]) -> tuple[list[Block], int]:
+    """The blocks of vertical faces: each a ring of faces linked at their corners, within one
+    lot; and how many small faces on no mass were left out."""
     by_lot: dict[str, list[Face]] = {}
     for f in faces:
         by_lot.setdefault(f.lot, []).append(f)
@@ -597,11 +710,50 @@ def model_from_terminals(
                 footprint=[(f.origin[0], f.origin[2]) for f in ring],
             )
         )
-    colors: dict[str, str] = {}
-    for t in terminals:  # a label's colour: the first one it comes in
-        if t.color is not None:
-            colors.setdefault(t.label, t.color)
-    return Model(blocks, source=path, roof_labels=roofs, label_colors=colors, dropped=dropped)
+    return blocks, dropped
+
+
+def _flats(read: list[tuple[Face, _Terminal]], frames: dict) -> tuple[list[Block], tuple[str, str]]:
+    """The blocks of a flat model, a face each (nothing to link: a flat façade has no corners),
+    and the lot's scope axes its faces run along, which the grammar's splits will name."""
+    first_face, first = read[0]
+    axes = _scope_axes(first_face, first, frames.get(first_face.lot))
+    blocks = []
+    for i, (face, _) in enumerate(read):
+        extent = {axes[0]: face.width, axes[1]: face.height}
+        corners = [(0.0, 0.0), (face.width, 0.0), (face.width, face.height), (0.0, face.height)]
+        footprint = [
+            tuple(face.origin[j] + a * face.x_axis[j] + b * face.y_axis[j] for j in (0, 2))
+            for a, b in corners
+        ]
+        blocks.append(
+            Block(
+                f"Block{i}",
+                [face],
+                extent.get("x", 0.0),
+                extent.get("z", 0.0),
+                0.0,
+                shape="flat",
+                footprint=footprint,
+            )
+        )
+    return blocks, axes
+
+
+def _scope_axes(face: Face, first: _Terminal, lot_axes) -> tuple[str, str]:
+    """The names of the lot's scope axes that the face's x and y run along: the lot axis each
+    is parallel to when the lot's frame is known, else the terminal's own scope axes (a piece
+    of a lot split in x and z has the lot's axes)."""
+    names = []
+    for vector, own in zip((face.x_axis, face.y_axis), first.plane, strict=True):
+        name = "xyz"[own]
+        if lot_axes is not None:
+            dots = [_dot(vector, a) for a in lot_axes]
+            best = max(range(3), key=lambda i: abs(dots[i]))
+            if dots[best] > 1.0 - 1e-6:
+                name = "xyz"[best]
+        names.append(name)
+    return names[0], names[1]
 
 
 def load_terminal_list(path: str | Path, fixed: dict[str, bool] | None = None) -> Model:
