@@ -108,6 +108,15 @@ OPERATIONS: dict[str, Op] = {
             "center(xz)",
         ),
         Op(
+            "reverseNormals",
+            "transforms",
+            _sig(),
+            "Turn a 2D shape over so that it faces the other way (as CGA's operation of that "
+            "name): a face's scope turns 180 degrees about its own y axis, so x and z reverse "
+            "and the outline stays where it is (a lot's turns about its z).",
+            "reverseNormals()",
+        ),
+        Op(
             "matrix",
             "transforms",
             (_MATRIX,),

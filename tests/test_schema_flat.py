@@ -278,10 +278,11 @@ def test_a_zero_size_face_is_skipped_cleanly():
 @pytest.mark.parametrize(
     "grammar",
     [
-        "terminal W\nLot --> extrude(0) comp(f) { side: W | all: NIL }\n",  # four faces of height 0
+        # four walls squashed to height 0 (a prism of height 0 has no side faces at all)
+        "terminal W\nLot --> extrude(3) comp(f) { side: s('1, 0, 0) W | all: NIL }\n",
         "terminal W\nLot --> s('1, 0, 0) W\n",  # a lot squashed to a line
     ],
-    ids=["extrude-0", "line-lot"],
+    ids=["squashed-walls", "line-lot"],
 )
 def test_only_zero_size_faces_is_a_located_error(grammar, tmp_path, capsys):
     terms = tmp_path / "t.json"

@@ -256,3 +256,43 @@ def test_ridge_trims_sit_on_the_roof_of_a_rectangle():
 def test_ridge_trims_give_way_to_a_plain_gable_off_the_rectangle(tmp_path):
     labels = {t["label"] for t in terminals(RIDGE, lot=_trapezoid(tmp_path))}
     assert "Roof" in labels and not labels & {"Ridge", "Eave", "Chimney"}
+
+
+def test_a_prism_of_zero_height_has_no_side_faces():
+    src = (
+        "Lot --> extrude(0) comp(f) { side: split(x) { ~1: W | ~1: W } | top: T | all: NIL }\n"
+        "terminal W, T\n"
+    )
+    assert [t["label"] for t in terminals(src)] == ["T"]
+
+
+@pytest.mark.parametrize("window", ["Plain", "Shop", "Arched"])
+def test_stdlib_reveals_close_the_opening_and_face_into_it(window):
+    """The four sides of a recessed window meet the wall's opening edge to edge (no see-through
+    sliver) and face into the hole, so a one-sided renderer draws them."""
+    src = (
+        "import stdlib.window as win\n"
+        "terminal Wall\n"
+        "Lot --> s(4, 0, 4) extrude(3) comp(f) { front: F | all: NIL }\n"
+        "F --> split(x) { ~1: Wall | 1.2: split(y) { 0.8: Wall | 1.5: O | ~1: Wall } | ~1: Wall }\n"
+        f"O --> win.{window}\n"
+    )
+    ts = terminals(src)
+    # the front wall is the plane z = 0 (facing -z); the opening x 1.4..2.6, y 0.8..2.3
+    reveals = [t for t in ts if t["label"] == "Wall" and abs(t["axes"][2][2]) < 1e-9]
+    assert reveals, "the window has reveal faces"
+    centre = np.array([2.0, 1.55])
+    lo_all = np.min([box(t)[0] for t in reveals], axis=0)
+    hi_all = np.max([box(t)[1] for t in reveals], axis=0)
+    assert lo_all[2] == pytest.approx(0.0, abs=1e-9)  # from the wall face ...
+    assert lo_all[0] == pytest.approx(1.4) and hi_all[0] == pytest.approx(2.6)  # ... round the
+    # opening, up to its head (an arch's head is a polygon: its highest vertex may sit a few
+    # millimetres under the opening's top)
+    assert hi_all[1] == pytest.approx(2.3, abs=0.01)
+    for t in reveals:
+        lo, hi = box(t)
+        assert lo[2] == pytest.approx(0.0, abs=1e-9)  # every side starts at the wall face
+        mid = (lo + hi) / 2
+        normal = np.array(t["axes"][2])
+        to_centre = np.array([centre[0] - mid[0], centre[1] - mid[1], 0.0])
+        assert normal @ to_centre > 0, f"{t['path']} faces away from the hole"

@@ -14,6 +14,7 @@ IMPLEMENTATIONS = {
     "s": transforms.scale,
     "center": transforms.center,
     "matrix": transforms.matrix,
+    "reverseNormals": transforms.reverse_normals,
     "split": splits.split,
     "comp": components.comp,
     "offset": components.offset,

@@ -65,7 +65,9 @@ def _faces(app, step, shape):
             for ext, holes in polys
         ]
     faces = []
-    for ext, holes in polys:
+    # a prism of zero height has no side faces: they would have no area (and no frame)
+    sides = polys if size[k] > 1e-12 else []
+    for ext, holes in sides:
         for ring, is_hole in [(ext, False)] + [(h, True) for h in holes]:
             metric = [(u * size[p], v * size[q]) for u, v in ring]
             ccw = signed_area(metric) > 0

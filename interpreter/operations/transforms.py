@@ -6,7 +6,9 @@ from __future__ import annotations
 import math
 
 from ..expressions import runtime_error
-from ..shapes import cross, dot, normalise
+from ..geometry.meshes import PLANE_AXES
+from ..geometry.polygons import RECT
+from ..shapes import Flat, cross, dot, normalise
 
 
 def _amounts(app, step, shape, values) -> list[float]:
@@ -96,3 +98,45 @@ def matrix(app, shape, step, args) -> bool:
     shape.origin = new_origin
     shape.size = [shape.size[i] * lengths[i] for i in range(3)]
     return False
+
+
+def reverse_normals(app, shape, step, args) -> bool:
+    """Turn a 2D shape over: half a turn about an axis in its plane, the outline kept in place.
+
+    Faces are one-sided in the files people open (glTF materials are not double-sided), so a
+    face seen from behind disappears: a window reveal made from the faces of the recess prism
+    looks into the wall until it is turned over.  A face (flat along z) turns about its y, so
+    its x and z reverse; a lot (flat along y) about its z.
+    """
+    geom = shape.geom
+    if not isinstance(geom, Flat):
+        raise runtime_error(
+            app.module,
+            step.pos,
+            "reverseNormals() needs a 2D shape",
+            "turn a face over (from comp(f) or offset), not a solid",
+        )
+    k = geom.k
+    about = 2 if k == 1 else 1
+    flipped = [a for a in range(3) if a != about]  # the normal and one axis in the plane
+    move = [shape.size[a] if a in flipped else 0.0 for a in range(3)]
+    shape.origin = shape.world(tuple(move))
+    shape.axes = tuple(
+        tuple(-c for c in axis) if a in flipped else axis for a, axis in enumerate(shape.axes)
+    )
+    if geom.polys != RECT:
+        # the in-plane axis that reversed: mirror the outline along it so it stays in place
+        which = PLANE_AXES[k].index(next(a for a in flipped if a != k))
+        polys = [
+            (_mirror(ext, which), tuple(_mirror(h, which) for h in holes))
+            for ext, holes in geom.polys
+        ]
+        shape.geom = Flat(k, polys, geom.name)
+    return False
+
+
+def _mirror(ring, which: int) -> tuple:
+    """A unit ring mirrored along coordinate ``which``, its order reversed to keep its turn."""
+    if which == 0:
+        return tuple((1.0 - u, v) for u, v in reversed(ring))
+    return tuple((u, 1.0 - v) for u, v in reversed(ring))
