@@ -30,7 +30,19 @@ ROOF_KINDS = ("flat", "gable", "hip", "pyramid", "shed", "mansard", "gambrel")
 FOOTPRINT_KINDS = ("rect", "L", "U", "T", "cross", "circle")
 EXTRUDE_KINDS = ("face.normal", "world.up")
 PRIMITIVES = ("cube", "cylinder", "sphere", "quad", "wedge")
-COMP_SELECTORS = ("front", "back", "left", "right", "side", "top", "bottom", "all")
+COMP_SELECTORS = (
+    "front",
+    "back",
+    "left",
+    "right",
+    "side",
+    "top",
+    "bottom",
+    "vertical",
+    "horizontal",
+    "aslant",
+    "all",
+)
 OFFSET_SELECTORS = ("inside", "border")
 
 REQUIRED = object()

@@ -296,3 +296,33 @@ def test_stdlib_reveals_close_the_opening_and_face_into_it(window):
         normal = np.array(t["axes"][2])
         to_centre = np.array([centre[0] - mid[0], centre[1] - mid[1], 0.0])
         assert normal @ to_centre > 0, f"{t['path']} faces away from the hole"
+
+
+def test_comp_of_a_roof_gives_its_slopes_and_upright_gable_ends():
+    src = (
+        "Lot --> extrude(6) comp(f) { top: roof(gable, 40, 0.4) R | all: NIL }\n"
+        "R --> comp(f) { vertical: G | aslant: S | all: X }\n"
+        "terminal G, S, X\n"
+    )
+    ts = terminals(src, lot=(12, 8))
+    labels = sorted(t["label"] for t in ts)
+    assert labels == ["G", "G", "S", "S"]
+    # a gable end stands on the wall top (y = 6), not down at the eaves, where it would lie in
+    # the wall's own plane and flicker against it: 8 m wide, 4 tan(40) high
+    for g in by_label(ts, "G"):
+        assert g["axes"][1] == pytest.approx([0, 1, 0])  # upright, y up
+        assert g["size"] == pytest.approx([8.0, 4 * np.tan(np.radians(40)), 0.0])
+        assert box(g)[0][1] == pytest.approx(6.0)
+    for s in by_label(ts, "S"):
+        assert abs(s["axes"][2][1]) == pytest.approx(np.cos(np.radians(40)))
+
+
+def test_stdlib_gable_ends_are_wall_not_roof():
+    src = "import stdlib.roof as rf\nLot --> extrude(6) comp(f) { top: rf.RidgeGable | all: NIL }\n"
+    ts = terminals(src, lot=(12, 8))
+    for t in ts:
+        upright = abs(t["axes"][2][1]) < 1e-9 and t["geometry"] == "polygon"
+        if t["label"] == "Roof":
+            assert not upright, "a gable end drawn as roof"
+    gables = [t for t in ts if t["label"] == "Wall"]
+    assert len(gables) == 2 and all(t["color"] == "#d8c8a8" for t in gables)

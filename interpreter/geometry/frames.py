@@ -100,3 +100,54 @@ def is_parallel(a: Vec, b: Vec) -> bool:
     """Do two unit vectors point along one line (either way)?"""
     c = cross(a, b)
     return math.sqrt(dot(c, c)) < _PARALLEL
+
+
+def planar_faces(vertices, faces) -> list[tuple[list[list[list[float]]], list[float]]]:
+    """The planar faces of a triangle mesh: (rings of 3D points, unit normal) per face.
+
+    Triangles are grouped by their plane (normal and offset, to 1e-6 of the mesh's size), and
+    each group's triangles are merged into polygons (an outer ring and its holes) in that
+    plane, so a roof's slope or gable end comes out as one face, in the order the mesh first
+    uses each plane.  Degenerate triangles are ignored.
+    """
+    import numpy as np
+    import shapely
+    from shapely.geometry import Polygon
+
+    v = np.asarray(vertices, dtype=float)
+    f = np.asarray(faces, dtype=np.int64)
+    if len(f) == 0:
+        return []
+    a, b, c = v[f[:, 0]], v[f[:, 1]], v[f[:, 2]]
+    n = np.cross(b - a, c - a)
+    length = np.linalg.norm(n, axis=1)
+    scale = max(float(np.ptp(v, axis=0).max()), 1e-9)
+    keep = length > 1e-12 * scale * scale
+    n[keep] /= length[keep, None]
+    offset = np.einsum("ij,ij->i", n, a)
+    key = np.column_stack([np.round(n * 1e6), np.round(offset / scale * 1e6)]).astype(np.int64)
+    out = []
+    seen: dict[tuple, list[int]] = {}
+    for i in np.flatnonzero(keep):
+        seen.setdefault(tuple(key[i]), []).append(int(i))
+    for rows in seen.values():
+        normal = n[rows[0]]
+        ref = np.array([0.0, 1.0, 0.0]) if abs(normal[1]) < 0.9 else np.array([1.0, 0.0, 0.0])
+        e1 = np.cross(ref, normal)
+        e1 /= np.linalg.norm(e1)
+        e2 = np.cross(normal, e1)
+        plane = float(offset[rows[0]])
+        tris = [Polygon([(p @ e1, p @ e2) for p in (a[r], b[r], c[r])]) for r in rows]
+        merged = shapely.union_all(tris)
+        for poly in getattr(merged, "geoms", [merged]):
+            if not isinstance(poly, Polygon) or poly.area <= 1e-12 * scale * scale:
+                continue
+            poly = shapely.geometry.polygon.orient(poly.simplify(0.0))
+            rings = [_lift(r, e1, e2, plane, normal) for r in [poly.exterior, *poly.interiors]]
+            out.append((rings, normal.tolist()))
+    return out
+
+
+def _lift(ring, e1, e2, plane: float, normal) -> list[list[float]]:
+    """A ring of plane coordinates (x along e1, y along e2) back to 3D points on the plane."""
+    return [(x * e1 + y * e2 + plane * normal).tolist() for x, y in list(ring.coords)[:-1]]

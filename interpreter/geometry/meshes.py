@@ -137,3 +137,41 @@ def primitive(name: str) -> tuple[np.ndarray, np.ndarray]:
         v, f = np.array(verts), np.array(faces)
         return v, _orient(v, f, lambda c: c - 0.5)
     raise KeyError(name)
+
+
+def clip_below(
+    vertices: np.ndarray, faces: np.ndarray, select: np.ndarray, level: float = 0.0
+) -> tuple[np.ndarray, np.ndarray]:
+    """Cut away the part of the ``select``-ed triangles below ``level`` along z.
+
+    A roof's gable ends and a shed's side walls reach down to its eaves, below the top of the
+    wall they stand on; there they lie in the wall's own plane, and two coplanar faces flicker
+    (z-fighting) in every viewer.  Triangles keep their winding; the rest are untouched.
+    """
+    eps = 1e-9
+    kept = [faces[~select]]
+    extra: list[np.ndarray] = []
+    base = len(vertices)
+    for tri in faces[select]:
+        pts = vertices[tri]
+        z = pts[:, 2] - level
+        if (z >= -eps).all():
+            kept.append(tri[None, :])
+            continue
+        if (z <= eps).all():
+            continue
+        poly = []  # Sutherland-Hodgman against z >= level
+        for i in range(3):
+            p, q, zp, zq = pts[i], pts[(i + 1) % 3], z[i], z[(i + 1) % 3]
+            if zp >= -eps:
+                poly.append(p)
+            if (zp >= -eps) != (zq >= -eps):
+                poly.append(p + (q - p) * (zp / (zp - zq)))
+        if len(poly) < 3:
+            continue
+        ids = np.arange(base, base + len(poly))
+        base += len(poly)
+        extra.append(np.array(poly))
+        kept.append(np.array([[ids[0], ids[j], ids[j + 1]] for j in range(1, len(poly) - 1)]))
+    out_v = np.vstack([vertices, *extra]) if extra else vertices
+    return out_v, np.vstack(kept).astype(faces.dtype)

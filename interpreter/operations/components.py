@@ -9,7 +9,7 @@ import numpy as np
 from bgr.grammar import nodes as n
 
 from ..expressions import runtime_error
-from ..geometry.frames import WORLD_UP, extrusion_axes, reframe_flat
+from ..geometry.frames import WORLD_UP, extrusion_axes, planar_faces, reframe_flat
 from ..geometry.meshes import PLANE_AXES
 from ..geometry.polygons import (
     RECT,
@@ -34,12 +34,16 @@ def _faces(app, step, shape):
     if isinstance(geom, Solid) and geom.name == "cube":
         geom = Prism(1, RECT)
     if isinstance(geom, Solid):
-        raise runtime_error(
-            app.module,
-            step.pos,
-            f"comp(f) of a '{geom.name}' shape is not supported",
-            "comp(f) works on extruded shapes, boxes and 2D shapes",
-        )
+        if geom.name not in _MESH_FACES:
+            raise runtime_error(
+                app.module,
+                step.pos,
+                f"comp(f) of a '{geom.name}' shape is not supported",
+                "comp(f) works on extruded shapes, boxes, roofs, tapers and 2D shapes",
+            )
+        unit = app.engine.table.library.meshes[geom.mesh]
+        metres = unit.vertices * np.asarray(shape.size, dtype=float)
+        return [(rings, nrm, (0.0, 0.0)) for rings, nrm in planar_faces(metres, unit.faces)]
     size = shape.size
     k = geom.k
     p, q = PLANE_AXES[k]
@@ -141,6 +145,12 @@ def _left_right(rings, nrm, turns) -> tuple[float, float]:
     return turns if dot(a, x) <= dot(b, x) else (turns[1], turns[0])
 
 
+# solids whose planar faces comp(f) takes apart: a roof's slopes and gable ends, a taper's caps
+# and sides, an extrusion along world y (assets and the round primitives are left whole)
+_MESH_FACES = ("roof", "taper", "extrusion")
+_SIN_1_DEGREE = math.sin(math.radians(1.0))
+
+
 def _classify(nrm) -> str:
     """top, bottom, front, back, left or right, by the outward normal in the shape's scope."""
     x, y, z = nrm
@@ -182,20 +192,34 @@ def _face_shape(shape, rings, nrm):
     return face
 
 
-def _matches(app, key, kind: str, index: int) -> bool:
+def _slant(nrm) -> str:
+    """CGA's vertical, horizontal and aslant: the face's normal within 1 degree of the scope's
+    horizontal plane, within 1 degree of its y axis, or neither."""
+    y = abs(nrm[1])
+    if y <= _SIN_1_DEGREE:
+        return "vertical"
+    return "horizontal" if y >= math.cos(math.radians(1.0)) else "aslant"
+
+
+def _matches(app, key, kind: str, index: int, slant: str) -> bool:
     if isinstance(key, n.Call):  # face(i)
         return int(app.value(key.args[0])) == index
     name = key.name
-    return name == "all" or name == kind or (name == "side" and kind not in ("top", "bottom"))
+    if name in ("all", kind, slant):
+        return True
+    return name == "side" and kind not in ("top", "bottom")
 
 
 def comp(app, shape, step, args) -> bool:
     faces = _faces(app, step, shape)
     kinds = [_classify(nrm) for _, nrm, _ in faces]
+    slants = [_slant(nrm) for _, nrm, _ in faces]
     taken = [False] * len(faces)
     for entry in step.block.entries:
         chosen = [
-            i for i in range(len(faces)) if not taken[i] and _matches(app, entry.key, kinds[i], i)
+            i
+            for i in range(len(faces))
+            if not taken[i] and _matches(app, entry.key, kinds[i], i, slants[i])
         ]
         for i in chosen:
             taken[i] = True

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..expressions import runtime_error
-from ..geometry.meshes import PLANE_AXES
+from ..geometry.meshes import PLANE_AXES, clip_below
 from ..geometry.polygons import RECT, UNIT_SQUARE, metric
 from ..geometry.rect_roofs import rectangle_hip
 from ..shapes import Flat, Solid
@@ -36,7 +36,12 @@ def roof(app, shape, step, args) -> bool:
             app.module, step.pos, f"a negative overhang ({overhang:g}) is not a roof"
         )
     from ..geometry.roofs import roof_mesh
+    from .components import _into_extrusion_frame
 
+    if geom.k != 1:
+        # a roof stands up from its face as an extrusion does: y along the face's normal, x kept
+        # (CGA's frame), so that comp(f) of the roof finds its slopes and gable ends upright
+        geom, _ = _into_extrusion_frame(app, step, shape, "face.normal", 0.0)
     k = geom.k
     p, q = PLANE_AXES[k]
     polys = [(UNIT_SQUARE, ())] if geom.polys == RECT else geom.polys
@@ -54,9 +59,18 @@ def roof(app, shape, step, args) -> bool:
             raise runtime_error(
                 app.module, step.pos, f"cannot build a {kind} roof on this footprint: {e}"
             ) from None
-        verts.append(m.vertices)
-        faces.append(m.faces + base)
-        base += len(m.vertices)
+        walls = np.array([m.planes[i].kind in ("gable", "wall") for i in m.face_plane], dtype=bool)
+        m_vertices, m_faces = (
+            clip_below(m.vertices, m.faces, walls)
+            if walls.any()
+            else (
+                m.vertices,
+                m.faces,
+            )
+        )
+        verts.append(m_vertices)
+        faces.append(m_faces + base)
+        base += len(m_vertices)
     local = np.vstack(verts)
     tris = np.vstack(faces)
     # face-local (plane p, plane q, up) -> scope axes; an odd permutation flips the winding
