@@ -86,6 +86,12 @@ def build_parser() -> argparse.ArgumentParser:
     derive.add_argument(
         "--max-shapes", type=int, default=10_000_000, metavar="N", help="shape budget (10,000,000)"
     )
+    derive.add_argument(
+        "--strict",
+        action="store_true",
+        help="treat warnings as errors: a footprint that cannot be used, a property that does "
+        "not fit its attr, a roof built as another kind",
+    )
 
     render = commands.add_parser(
         "render",
@@ -309,7 +315,10 @@ def cmd_derive(args) -> int:
         lot=args.lot,
         max_depth=args.max_depth,
         max_shapes=args.max_shapes,
+        strict=args.strict,
     )
+    for warning in result.warnings:
+        print(warning.render(), file=sys.stderr)
     if args.output in (None, "-"):
         write_json(result.terminals, sys.stdout, seed=args.seed, attrs=result.attrs)
     else:

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import difflib
 from collections.abc import Iterable
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 
 @dataclass
@@ -21,10 +21,12 @@ class Diagnostic:
     hint: str | None = None
     source_line: str | None = None
     length: int = 1  # how many characters the caret underlines
+    severity: str = "error"  # or "warning": the run goes on (bgr derive prints it, Result keeps it)
 
     def render(self) -> str:
         where = f"{self.path}:{self.line}:{self.column}" if self.line else self.path
-        out = [f"{where}: error: {self.message}" if where else f"error: {self.message}"]
+        head = f"{self.severity}: {self.message}"
+        out = [f"{where}: {head}" if where else head]
         if self.source_line is not None and self.line:
             text = self.source_line.rstrip("\r\n")
             gutter = f"{self.line:>5} | "
@@ -60,6 +62,38 @@ class BgrError(Exception):
         if len(self.diagnostics) > 1:
             text += f"\n{len(self.diagnostics)} errors"
         return text
+
+
+class Warnings:
+    """Where the warnings of a run go: problems it works around (a footprint skipped, a property
+    ignored, a roof built as another kind) without stopping.
+
+    Each is kept once, as a one-line :class:`Diagnostic` of severity ``warning`` (its source line
+    and hint left out: a run over thousands of footprints may warn about hundreds); ``strict``
+    makes the first one an error instead, shown in full (``--strict``).
+    """
+
+    def __init__(self, strict: bool = False) -> None:
+        self.strict = strict
+        self.items: list[Diagnostic] = []
+        self._seen: set[tuple] = set()
+
+    def warn(self, diagnostic: Diagnostic, error: type[BgrError] | None = None) -> None:
+        """Keep ``diagnostic`` as a warning, or raise it (as ``error``, default BgrError) when
+        strict."""
+        if self.strict:
+            raise (error or BgrError)(replace(diagnostic, severity="error"))
+        self.add(diagnostic)
+
+    def add(self, diagnostic: Diagnostic) -> None:
+        """Keep a warning (once), whatever ``strict`` says."""
+        key = (diagnostic.path, diagnostic.line, diagnostic.column, diagnostic.message)
+        if key not in self._seen:
+            self._seen.add(key)
+            self.items.append(replace(diagnostic, severity="warning", hint=None, source_line=None))
+
+    def __len__(self) -> int:
+        return len(self.items)
 
 
 class BgrSyntaxError(BgrError):

@@ -3,15 +3,15 @@
 from __future__ import annotations
 
 import os
-from dataclasses import dataclass
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 from bgr.grammar.checker import Grammar
-from bgr.grammar.errors import BgrError
+from bgr.grammar.errors import BgrError, Diagnostic, Warnings
 from bgr.grammar.loader import load
 
 from .engine import DEFAULT_MAX_DEPTH, DEFAULT_MAX_SHAPES, Engine
-from .lots import DEFAULT_LOT, Lot, parse_lot_option, rectangle
+from .lots import DEFAULT_LOT, Lot, attr_overrides, parse_lot_option, rectangle
 from .randomness import child_hash, name_hash, root_hash
 from .terminals import TerminalTable
 
@@ -23,6 +23,9 @@ class Result:
     terminals: TerminalTable
     seed: int
     attrs: dict
+    # what the run worked around: footprints skipped or repaired, properties ignored, roofs
+    # built as another kind; one-line diagnostics (``d.render()``), in the order they happened
+    warnings: list[Diagnostic] = field(default_factory=list)
 
     def __len__(self) -> int:
         return len(self.terminals)
@@ -50,50 +53,78 @@ def derive(
     max_depth: int = DEFAULT_MAX_DEPTH,
     max_shapes: int = DEFAULT_MAX_SHAPES,
     start: str | None = None,
+    strict: bool = False,
 ) -> Result:
     """Derive a grammar on one lot or several.
 
     ``grammar`` is a checked :class:`bgr.Grammar` or anything :func:`bgr.load` takes.  ``lot`` is
     ``(width, depth)``, ``"W,D"``, a GeoJSON path, or a list of lots; the default is 20 x 20 m.
     Each GeoJSON feature's properties override attrs of the same name for its building.
+
+    What the run works around — a footprint it cannot use (skipped), a property that does not
+    fit its attr (ignored), a roof built as another kind — is in ``Result.warnings``; with
+    ``strict=True`` the first of them is a :class:`bgr.BgrError` instead.  An error raised while
+    deriving one of several lots names the lot ("feature 12 (id 4253124): ...").
     """
     if not isinstance(grammar, Grammar):
         grammar = load(grammar)
     if isinstance(seed, bool) or not isinstance(seed, int):
         raise BgrError(f"the seed must be a whole number, got {seed!r}")
-    lots = _lots(lot)
+    warnings = Warnings(strict)
+    lots = _lots(lot, warnings)
     attrs = dict(attrs or {})
+    values = Engine(grammar, seed, attrs, max_depth, max_shapes).attrs  # the run's attrs
     table = TerminalTable()
     shared_cache: dict = {}
+    several = len(lots) > 1
     for i, each in enumerate(lots):
-        overrides = dict(attrs)
-        overrides.update(
-            {
-                k: v
-                for k, v in each.properties.items()
-                if k in grammar.attrs and isinstance(v, (int, float, str, bool)) and v is not None
-            }
-        )
-        engine = Engine(grammar, seed, overrides, max_depth, max_shapes, lot_index=i)
-        engine.table = table
-        engine.split_cache = shared_cache
-        shape = each.shape.copy()
-        engine.derive(shape, start, index=i, several=len(lots) > 1)
+        lot_name = each.name or (f"lot {i}" if several else "")
+        try:
+            overrides = dict(attrs)
+            overrides.update(attr_overrides(each, values, warnings))
+            engine = Engine(
+                grammar,
+                seed,
+                overrides,
+                max_depth,
+                max_shapes,
+                lot_index=i,
+                warnings=warnings,
+                lot_name=lot_name,
+            )
+            engine.table = table
+            engine.split_cache = shared_cache
+            engine.derive(each.shape.copy(), start, index=i, several=several)
+        except BgrError as e:
+            raise _naming(e, lot_name) from None
         lot_shape = each.shape  # its frame: the inverse modules read a face's side in it
         name = start or grammar.start
         table.lots.append(
             {
-                "path": f"{name}.{i}" if len(lots) > 1 else name,
+                "path": f"{name}.{i}" if several else name,
                 "origin": list(lot_shape.origin),
                 "axes": [list(a) for a in lot_shape.axes],
                 "size": list(lot_shape.size),
             }
         )
-    values = Engine(grammar, seed, attrs, max_depth, max_shapes).attrs if lots else attrs
-    return Result(table.freeze(), seed, values)
+    return Result(table.freeze(), seed, values, list(warnings.items))
 
 
-def _lots(lot) -> list[Lot]:
+def _naming(error: BgrError, lot_name: str) -> BgrError:
+    """The error with the lot it happened on named at the start of each message (the location
+    stays the grammar's ``file:line:col``); unchanged when the run has one unnamed lot."""
+    if not lot_name:
+        return error
+    named = [
+        d
+        if d.message.startswith(f"{lot_name}: ")
+        else replace(d, message=f"{lot_name}: {d.message}")
+        for d in error.diagnostics
+    ]
+    return type(error)(named)
+
+
+def _lots(lot, warnings: Warnings) -> list[Lot]:
     if lot is None:
         return [rectangle(*DEFAULT_LOT)]
     if (
@@ -103,7 +134,7 @@ def _lots(lot) -> list[Lot]:
     ):
         return [rectangle(float(lot[0]), float(lot[1]))]
     if isinstance(lot, (str, os.PathLike)):
-        return parse_lot_option(str(lot))
+        return parse_lot_option(str(lot), warnings)
     if isinstance(lot, Lot):
         return [lot]
     return list(lot)

@@ -9,10 +9,11 @@ looked up by name in :mod:`bgr.interpreter.operations`, one function each.
 from __future__ import annotations
 
 import gc
+from dataclasses import replace
 
 from bgr.grammar import nodes as n
 from bgr.grammar.checker import bind_problem
-from bgr.grammar.errors import BgrError, Diagnostic, suggest
+from bgr.grammar.errors import BgrError, Diagnostic, Warnings, suggest
 from bgr.grammar.registry import (
     AXES,
     AXIS,
@@ -59,8 +60,12 @@ class Engine:
         max_depth: int = DEFAULT_MAX_DEPTH,
         max_shapes: int = DEFAULT_MAX_SHAPES,
         lot_index: int = 0,
+        warnings: Warnings | None = None,
+        lot_name: str = "",
     ) -> None:
         self.grammar, self.seed, self.lot_index = grammar, seed, lot_index
+        self.warnings = warnings if warnings is not None else Warnings()
+        self.lot_name = lot_name  # put before warnings' messages: "feature 12 (id 4253124): ..."
         self.max_depth, self.max_shapes = max_depth, max_shapes
         self.compilers: dict[int, Compiler] = {}
         self.attrs = self._prepare_values(grammar, dict(attrs or {}))
@@ -160,6 +165,17 @@ class Engine:
                 found = (None, f"terminal '{ref.member}' takes no arguments", None)
             self._bindings[key] = found
         return self._bindings[key]
+
+    def warn(self, module, pos, message: str, hint: str | None = None) -> None:
+        """A located warning (the grammar's place and the lot's name); an error when strict."""
+        error = runtime_error(module, pos, message, hint)
+        if self.warnings.strict:
+            raise error
+        if self.lot_name:
+            error.diagnostics[0] = replace(
+                error.diagnostics[0], message=f"{self.lot_name}: {message}"
+            )
+        self.warnings.add(error.diagnostics[0])
 
     def count_shape(self, module, pos) -> None:
         self.shapes += 1

@@ -2,26 +2,51 @@
 
 A lot is a 2D shape in the xz plane (y up, sy = 0) whose scope has x along the footprint's first
 edge (its front, the street side) and z pointing into the lot (LANGUAGE.md section 4).
+
+Footprints from real data (OpenStreetMap, cadastres) are rarely clean: rings that cross
+themselves, repeated and collinear corners, slivers of no width, coordinates as longitude and
+latitude, numbers written as strings.  :func:`read_geojson` makes each feature a usable lot or
+skips it with one warning naming it (docs/cli.md, "Lots", states the rules), so that one bad
+feature among thousands does not stop a run.
 """
 
 from __future__ import annotations
 
 import math
+import re
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from bgr.grammar.errors import BgrError, Diagnostic, read_json
+import numpy as np
+import shapely
+from shapely.geometry import Polygon
+from shapely.validation import make_valid
 
+from bgr.grammar.errors import BgrError, Diagnostic, Warnings, read_json
+
+from .geometry.earclip import signed_area as ring_area
 from .geometry.polygons import RECT, is_unit_square, normalise, signed_area
 from .shapes import IDENTITY, Flat, Shape
 
 DEFAULT_LOT = (20.0, 20.0)
+CLEAN_TOL = 1e-3  # metres: a corner this close to the previous one or to a straight line goes
+MIN_WIDTH = 0.05  # metres: an outline whose mean width (2 area / perimeter) is less is skipped
+
+# WGS84: the local projection of longitude/latitude uses the ellipsoid's radii of curvature
+_WGS84_A = 6_378_137.0
+_WGS84_E2 = 6.694_379_990_14e-3
 
 
 @dataclass
 class Lot:
     shape: Shape
     properties: dict = field(default_factory=dict)
+    name: str = ""  # how messages name it, e.g. "feature 12 (id 4253124)"; "" for --lot W,D
+    source: str = ""  # the file it came from, where property warnings point
+
+
+class FootprintError(ValueError):
+    """A feature's outline cannot be a lot; the message says why (it follows "skipped: ")."""
 
 
 def rectangle(width: float, depth: float) -> Lot:
@@ -30,7 +55,9 @@ def rectangle(width: float, depth: float) -> Lot:
     return Lot(Shape((0.0, 0.0, 0.0), IDENTITY, (width, 0.0, depth), Flat(1, RECT)))
 
 
-def footprint(points_xz: list[tuple[float, float]], properties: dict | None = None) -> Lot:
+def footprint(
+    points_xz: list[tuple[float, float]], properties: dict | None = None, name: str = ""
+) -> Lot:
     """A lot on a polygon given in world (x, z), first edge = front."""
     pts = [tuple(map(float, p)) for p in points_xz]
     if len(pts) > 1 and pts[0] == pts[-1]:
@@ -48,15 +75,15 @@ def footprint(points_xz: list[tuple[float, float]], properties: dict | None = No
     ]
     centroid_w = sum(w for _, w in local) / len(local)
     if centroid_w < 0:
-        return footprint([pts[1], pts[0], *reversed(pts[2:])], properties)
+        return footprint([pts[1], pts[0], *reversed(pts[2:])], properties, name)
     unit, (u0, w0, width, depth) = normalise([(tuple(local), ())])
     origin = (x0 + u0 * xa[0] + w0 * za[0], 0.0, z0 + u0 * xa[2] + w0 * za[2])
     axes = (xa, (0.0, 1.0, 0.0), za)
     geom = Flat(1, RECT if is_unit_square(unit) else [(tuple(unit[0][0]), ())])
-    return Lot(Shape(origin, axes, (width, 0.0, depth), geom), dict(properties or {}))
+    return Lot(Shape(origin, axes, (width, 0.0, depth), geom), dict(properties or {}), name)
 
 
-def parse_lot_option(value: str) -> list[Lot]:
+def parse_lot_option(value: str, warnings: Warnings | None = None) -> list[Lot]:
     """``W,D`` or a GeoJSON file of footprints."""
     if "," in value and not value.lower().endswith((".json", ".geojson")):
         try:
@@ -67,18 +94,24 @@ def parse_lot_option(value: str) -> list[Lot]:
                 "or give a GeoJSON file"
             ) from None
         return [rectangle(width, depth)]
-    return read_geojson(Path(value))
+    return read_geojson(Path(value), warnings)
 
 
-def read_geojson(path: Path) -> list[Lot]:
-    """Every Polygon / MultiPolygon feature becomes a lot (its exterior ring).
+# --------------------------------------------------------------------------------------------
+# GeoJSON
+
+
+def read_geojson(path: Path, warnings: Warnings | None = None) -> list[Lot]:
+    """Every Polygon / MultiPolygon feature becomes a lot (the outer ring of each polygon).
 
     Longitude/latitude (every coordinate within +-180, +-90 and the whole set within one degree)
-    are projected to metres around the collection's centre (equirectangular, good to a few
-    centimetres over a city district); other coordinates are taken as metres.  East is +x,
-    north is -z.
+    are projected to metres around the collection's centre; other coordinates are taken as
+    metres.  East is +x, north is -z.  Each outline is cleaned by :func:`clean_ring`; a feature
+    that cannot be used is reported to ``warnings`` (one line naming it; an error when strict)
+    and skipped.  A file with no usable footprint at all is an error.
     """
     shown = str(path)
+    warnings = warnings if warnings is not None else Warnings()
     data = read_json(path, "lot file", "give W,D or a GeoJSON file")
     features = data.get("features") if isinstance(data, dict) else None
     if isinstance(data, dict) and data.get("type") == "Feature":
@@ -87,45 +120,310 @@ def read_geojson(path: Path) -> list[Lot]:
         raise BgrError(
             Diagnostic(shown, 0, 0, "a lot file must be a GeoJSON FeatureCollection or Feature")
         )
-    rings = []
-    for i, feature in enumerate(features):
-        geometry = (feature or {}).get("geometry") or {}
-        kind, coords = geometry.get("type"), geometry.get("coordinates")
-        try:
-            if kind == "Polygon":
-                rings.append((coords[0], feature.get("properties") or {}, i))
-            elif kind == "MultiPolygon":
-                rings += [(poly[0], feature.get("properties") or {}, i) for poly in coords]
-        except (TypeError, IndexError):
-            raise BgrError(
-                Diagnostic(shown, 0, 0, f"feature {i}: malformed {kind} coordinates")
-            ) from None
-    if not rings:
-        raise BgrError(Diagnostic(shown, 0, 0, "the lot file has no Polygon features"))
-    try:
-        flat = [(float(c[0]), float(c[1])) for ring, _, _ in rings for c in ring]
-    except (TypeError, ValueError, IndexError):
-        raise BgrError(Diagnostic(shown, 0, 0, "coordinates must be [x, y] numbers")) from None
-    xs, ys = [x for x, _ in flat], [y for _, y in flat]
-    geographic = (
-        all(abs(x) <= 180 and abs(y) <= 90 for x, y in flat)
-        and max(xs) - min(xs) < 1.0
-        and max(ys) - min(ys) < 1.0
-    )
-    lon0 = sum(x for x, _ in flat) / len(flat)
-    lat0 = sum(y for _, y in flat) / len(flat)
-    kx, ky = (111_320.0 * math.cos(math.radians(lat0)), 110_540.0) if geographic else (1.0, 1.0)
-    lots = []
-    for ring, props, i in rings:
-        pts = [
-            (
-                (float(c[0]) - (lon0 if geographic else 0)) * kx,
-                -(float(c[1]) - (lat0 if geographic else 0)) * ky,
+
+    def skip(name: str, why: str) -> None:
+        warnings.warn(
+            Diagnostic(
+                shown,
+                0,
+                0,
+                f"{name} skipped: {why}",
+                "without --strict it is skipped with a warning",
             )
-            for c in ring
-        ]
+        )
+
+    rings = []  # (name, coordinates (k, 2), properties)
+    polygons = 0  # features with a Polygon or MultiPolygon geometry
+    for i, feature in enumerate(features):
+        feature = feature if isinstance(feature, dict) else {}
+        name = feature_name(i, feature)
+        properties = feature.get("properties")
+        properties = properties if isinstance(properties, dict) else {}
+        geometry = feature.get("geometry")
+        polygons += isinstance(geometry, dict) and geometry.get("type") in _POLYGONS
         try:
-            lots.append(footprint(pts, props))
-        except BgrError as e:
-            raise BgrError(Diagnostic(shown, 0, 0, f"feature {i}: {e.message}")) from None
+            outlines = _outer_rings(feature)
+        except FootprintError as e:
+            skip(name, str(e))
+            continue
+        for part, ring in enumerate(outlines):
+            part_name = f"{name}, part {part}" if len(outlines) > 1 else name
+            if isinstance(ring, FootprintError):
+                skip(part_name, str(ring))
+            else:
+                rings.append((part_name, ring, properties))
+
+    lots = []
+    for name, ring, properties in _project(rings):
+        try:
+            outline, note = clean_ring(ring)
+        except FootprintError as e:
+            skip(name, str(e))
+            continue
+        if note:
+            warnings.warn(
+                Diagnostic(shown, 0, 0, f"{name}: {note}", "without --strict it is repaired")
+            )
+        lot = footprint([tuple(p) for p in outline], properties, name)
+        lot.source = shown
+        lots.append(lot)
+    if not lots:
+        what = "no usable footprint" if polygons else "no Polygon features"
+        raise BgrError(Diagnostic(shown, 0, 0, f"the lot file has {what}"))
     return lots
+
+
+_POLYGONS = ("Polygon", "MultiPolygon")
+
+
+def feature_name(index: int, feature: dict) -> str:
+    """How messages name a feature: its index in the file and its id (GeoJSON's ``id`` member,
+    else an ``id`` property, as OpenStreetMap exports have)."""
+    ident = feature.get("id")
+    if ident is None and isinstance(feature.get("properties"), dict):
+        ident = feature["properties"].get("id")
+    return f"feature {index} (id {ident})" if ident is not None else f"feature {index} (no id)"
+
+
+def _outer_rings(feature: dict) -> list:
+    """The outer ring of each polygon of a feature, as (k, 2) float arrays; a polygon of a
+    MultiPolygon that is malformed is a FootprintError in its place, so the others still count."""
+    geometry = feature.get("geometry")
+    if not isinstance(geometry, dict):
+        raise FootprintError("it has no geometry")
+    kind, coords = geometry.get("type"), geometry.get("coordinates")
+    if kind == "Polygon":
+        return [_ring(coords)]
+    if kind == "MultiPolygon":
+        if not isinstance(coords, list) or not coords:
+            raise FootprintError("malformed MultiPolygon coordinates")
+        out = []
+        for poly in coords:
+            try:
+                out.append(_ring(poly))
+            except FootprintError as e:
+                out.append(e)
+        return out
+    raise FootprintError(f"a {kind} is not a footprint" if kind else "its geometry has no type")
+
+
+def _ring(polygon) -> np.ndarray:
+    """The outer ring of GeoJSON Polygon coordinates (holes are left out: see clean_ring)."""
+    if not isinstance(polygon, list) or not polygon or not isinstance(polygon[0], list):
+        raise FootprintError("malformed Polygon coordinates")
+    try:
+        ring = np.array([(float(c[0]), float(c[1])) for c in polygon[0]], dtype=np.float64).reshape(
+            -1, 2
+        )
+    except (TypeError, ValueError, IndexError, KeyError):
+        raise FootprintError("its coordinates are not [x, y] numbers") from None
+    if not np.isfinite(ring).all():
+        raise FootprintError("its coordinates are not all finite")
+    return ring
+
+
+def _project(items: list) -> list:
+    """Each (name, ring, properties) item with its ring in metres: longitude/latitude (see
+    read_geojson) projected about the centre of the collection's bounding box, which becomes
+    the origin; east is +x, north is -z.
+
+    The projection is equirectangular on the WGS84 ellipsoid: metres per degree are the radii of
+    curvature at the centre's latitude, so lengths and angles are right at the centre and off by
+    about 1 part in 10,000 a kilometre north or south of it.
+    """
+    if not items:
+        return []
+    flat = np.concatenate([ring for _, ring, _ in items])
+    lo, hi = flat.min(axis=0), flat.max(axis=0)
+    geographic = (
+        bool((np.abs(flat[:, 0]) <= 180).all() and (np.abs(flat[:, 1]) <= 90).all())
+        and hi[0] - lo[0] < 1.0
+        and hi[1] - lo[1] < 1.0
+    )
+    if geographic:
+        centre = (lo + hi) / 2.0
+        phi = math.radians(float(centre[1]))
+        w = math.sqrt(1.0 - _WGS84_E2 * math.sin(phi) ** 2)
+        per_degree = math.pi / 180.0
+        scale = np.array(
+            [
+                _WGS84_A / w * math.cos(phi) * per_degree,  # prime vertical radius N cos(phi)
+                -_WGS84_A * (1.0 - _WGS84_E2) / w**3 * per_degree,  # meridian radius M; north -z
+            ]
+        )
+    else:
+        centre, scale = np.zeros(2), np.array([1.0, -1.0])
+    return [(name, (ring - centre) * scale, props) for (name, ring, props) in items]
+
+
+# --------------------------------------------------------------------------------------------
+# cleaning one outline
+
+
+def clean_ring(ring) -> tuple[np.ndarray, str | None]:
+    """A footprint outline (k, 2) in metres made fit to build on, and a note when that lost
+    part of it; raises FootprintError when nothing usable is left.
+
+    - the closing point and corners within CLEAN_TOL of the previous one are dropped;
+    - an outline that crosses or touches itself is repaired with shapely's ``make_valid`` and
+      the largest polygon it yields is kept (the note says how much was dropped); holes are not
+      kept, here or in the input, so a courtyard is built over;
+    - corners within CLEAN_TOL of the straight line through their neighbours are dropped;
+    - an outline whose mean width (2 area / perimeter) is under MIN_WIDTH is not used.
+
+    The first edge (the front) stays the one that carries the input's first edge; a repaired
+    outline starts at its corner nearest the input's first corner and keeps its orientation.
+    """
+    pts = _drop_repeats(np.asarray(ring, dtype=np.float64))
+    if len(pts) < 3:
+        raise FootprintError("its outline has fewer than three distinct corners")
+    note = None
+    poly = Polygon(pts)
+    if not poly.is_valid:
+        pts, note = _repair(pts, poly)
+    kept = _drop_straight(pts)
+    if len(kept) >= 3 and Polygon(pts[kept]).is_valid:
+        # the front edge is the kept edge that carries input edge 0: start at the last kept
+        # corner at or before corner 0 (cyclically)
+        start = kept.index(0) if 0 in kept else len(kept) - 1
+        pts = pts[kept[start:] + kept[:start]]
+    area, perimeter = abs(ring_area(pts)), float(_lengths(pts).sum())
+    if area == 0 or 2 * area / perimeter < MIN_WIDTH:
+        raise FootprintError(
+            "its outline has no area"
+            if area < 1e-6
+            else f"its outline is thinner than {MIN_WIDTH * 100:g} cm ({area:.2g} m²)"
+        )
+    return pts, note
+
+
+def _lengths(pts: np.ndarray) -> np.ndarray:
+    return np.linalg.norm(np.roll(pts, -1, axis=0) - pts, axis=1)
+
+
+def _drop_repeats(pts: np.ndarray) -> np.ndarray:
+    """The ring without its closing point and without corners within CLEAN_TOL of the one
+    before (a corner is compared with the last one kept, so a run of near-repeats is one)."""
+    kept = [0]
+    for i in range(1, len(pts)):
+        if np.linalg.norm(pts[i] - pts[kept[-1]]) > CLEAN_TOL:
+            kept.append(i)
+    while len(kept) > 1 and np.linalg.norm(pts[kept[-1]] - pts[kept[0]]) <= CLEAN_TOL:
+        kept.pop()
+    return pts[kept]
+
+
+def _drop_straight(pts: np.ndarray) -> list[int]:
+    """Indices of the corners that are not within CLEAN_TOL of the straight line through their
+    neighbours (lying between them); repeated until none is left, so a run of them goes."""
+    keep = list(range(len(pts)))
+    changed = True
+    while changed and len(keep) > 3:
+        changed = False
+        a, b, c = pts[np.roll(keep, 1)], pts[keep], pts[np.roll(keep, -1)]
+        ac = c - a
+        span = np.linalg.norm(ac, axis=1)
+        off = np.abs(ac[:, 0] * (b - a)[:, 1] - ac[:, 1] * (b - a)[:, 0]) / np.maximum(span, 1e-300)
+        between = np.einsum("ij,ij->i", b - a, c - b) > 0
+        straight = np.flatnonzero((span > CLEAN_TOL) & (off <= CLEAN_TOL) & between)
+        if len(straight):
+            del keep[int(straight[np.argmin(off[straight])])]  # the straightest first
+            changed = True
+    return keep
+
+
+def _repair(pts: np.ndarray, poly: Polygon) -> tuple[np.ndarray, str | None]:
+    """The largest polygon ``make_valid`` makes of a self-crossing outline, as a ring in the
+    input's orientation starting at the corner nearest the input's first one."""
+    fixed = make_valid(poly)
+    parts = [
+        g
+        for g in shapely.get_parts(fixed)
+        for g in (shapely.get_parts(g) if g.geom_type == "GeometryCollection" else [g])
+        if g.geom_type in ("Polygon", "MultiPolygon")
+    ]
+    polygons = [p for g in parts for p in shapely.get_parts(g) if p.area > 0]
+    if not polygons:
+        raise FootprintError("its outline has no area")
+    best = max(polygons, key=lambda p: p.area)
+    ring = np.array(best.exterior.coords[:-1], dtype=np.float64)
+    if (ring_area(ring) > 0) != (ring_area(pts) > 0):
+        ring = ring[::-1]
+    ring = np.roll(ring, -int(np.argmin(np.linalg.norm(ring - pts[0], axis=1))), axis=0)
+    note = None
+    if len(polygons) > 1:
+        total = sum(p.area for p in polygons)
+        note = (
+            f"its outline crosses itself; repaired, keeping the largest of its {len(polygons)} "
+            f"parts ({best.area:.3g} of {total:.3g} m²)"
+        )
+    return _drop_repeats(ring), note
+
+
+# --------------------------------------------------------------------------------------------
+# properties
+
+
+_NUMBER = re.compile(r"[+-]?(?:[0-9]+(?:\.[0-9]*)?|\.[0-9]+)(?:[eE][+-]?[0-9]+)?")
+_INTEGER = re.compile(r"[+-]?[0-9]+")
+
+
+def number_of(text: str) -> int | float | None:
+    """The number a property string spells — ``"6"`` is 6, ``"12.5"`` is 12.5, surrounding
+    spaces allowed — or None: no digit separators (``"1_000"``), no non-ASCII digits, no
+    ``inf`` or ``nan`` (Python's ``float`` takes all three; data should not)."""
+    text = text.strip()
+    if not _NUMBER.fullmatch(text):
+        return None
+    value = int(text) if _INTEGER.fullmatch(text) else float(text)
+    return value if math.isfinite(value) else None
+
+
+def _is_number(value) -> bool:
+    return isinstance(value, (int, float)) and not isinstance(value, bool)
+
+
+def attr_overrides(lot: Lot, attrs: dict, warnings: Warnings) -> dict:
+    """The attr values a lot's properties give: a property overrides the attr of its name when
+    its value fits the attr's type (the run's value of the attr): a number attr takes a finite
+    number or a string that is one (:func:`number_of`), a string attr a string, a boolean attr a
+    boolean.  ``null`` and names that are no attr are ignored; a value that does not fit is
+    reported (naming the lot) and the attr keeps its value."""
+    out = {}
+    for key, value in lot.properties.items():
+        if key not in attrs or value is None:
+            continue
+        current = attrs[key]
+        if _is_number(current):
+            fitted = number_of(value) if isinstance(value, str) else value
+            ok = _is_number(fitted) and math.isfinite(fitted)
+            need = "a number"
+        elif isinstance(current, bool):
+            fitted, ok, need = value, isinstance(value, bool), "true or false"
+        elif isinstance(current, str):
+            fitted, ok, need = value, isinstance(value, str), "a string"
+        else:
+            fitted, ok, need = value, isinstance(value, (int, float, str, bool)), "a value"
+        if ok:
+            out[key] = fitted
+        else:
+            warnings.warn(
+                Diagnostic(
+                    lot.source,
+                    0,
+                    0,
+                    f"{lot.name}: property '{key}' is {_shown(value)}, not {need}; "
+                    f"the attr '{key}' keeps its value",
+                    "without --strict the property is ignored with a warning",
+                )
+            )
+    return out
+
+
+def _shown(value) -> str:
+    import json
+
+    try:
+        return json.dumps(value, ensure_ascii=False, allow_nan=True)[:60]
+    except (TypeError, ValueError):
+        return repr(value)[:60]
