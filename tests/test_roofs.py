@@ -21,6 +21,7 @@ from bgr.interpreter.geometry.earclip import triangulate
 from bgr.interpreter.geometry.roofs import (
     KINDS,
     MANSARD_BREAK,
+    MITRE_LIMIT,
     RoofMesh,
     mansard_lower_pitch,
     roof_mesh,
@@ -449,3 +450,88 @@ def test_offset_outward_closes_a_narrow_notch():
     ring, source = offset_outward(poly, 0.6)  # the notch is gone; the arms' tops meet in line
     assert np.allclose(ring, [(-0.6, 8.6), (-0.6, -0.6), (9.6, -0.6), (9.6, 8.6), (4.5, 8.6)])
     assert list(source) == [7, 0, 1, 2, 6]
+
+
+# ---------------------------------------------------------------------------------------------
+# sharp corners: the eave is bevelled, not mitred to infinity
+
+SHARP = {
+    "triangle": [(0, 0), (30, 0), (30, 10.9)],  # a 20-degree corner
+    "flatiron": [(0, 0), (40, 0), (10, 12), (0, 12)],  # a 22-degree corner
+    "kite": [(0, 0), (10, -1), (30, 0), (10, 1)],  # 6 and 11 degrees
+    # a Helsinki building (OSM way 123412759) with a 0.07-degree needle: its mitred eave went
+    # 670 m out, a pyramid's 2 km
+    "needle": [
+        (0, 1.0679),
+        (22.6712, 0),
+        (23.0133, 7.3577),
+        (20.8704, 7.4571),
+        (20.8094, 6.1859),
+        (10.8256, 6.6391),
+        (10.5487, 0.5816),
+        (9.1477, 0.6479),
+    ],
+}
+
+
+@pytest.mark.parametrize("kind", KINDS)
+@pytest.mark.parametrize("name", list(SHARP))
+def test_sharp_corners_keep_the_eave_near(name, kind):
+    poly, over = np.array(SHARP[name], dtype=float), 0.5
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        mesh = roof_mesh(poly, kind, PITCH, over)
+    assert np.isfinite(mesh.vertices).all() and not mesh.fallback
+    area = Polygon(poly)
+    reach = max(area.distance(shapely.Point(v)) for v in mesh.vertices[:, :2])
+    assert reach <= MITRE_LIMIT * over + TOL
+    for face, p in zip(mesh.faces, mesh.face_plane, strict=True):
+        plane = mesh.planes[p]
+        assert np.allclose(mesh.vertices[face] @ plane.normal, plane.offset, atol=TOL)
+    if kind != "flat":
+        solid = capped(mesh)
+        assert solid.is_watertight and solid.is_winding_consistent and solid.volume > 0
+    if kind in ("hip", "mansard"):  # the bevel's facet rises through the corner at z = 0
+        corners = [p for p in mesh.planes if p.kind == "corner"]
+        assert corners and all(p.pitch == pytest.approx(mesh.planes[0].pitch) for p in corners)
+        for p in corners:
+            assert min(abs(np.append(c, 0.0) @ p.normal - p.offset) for c in poly) < TOL
+    assert not any(p.kind == "corner" for p in roof_mesh(poly, kind, PITCH).planes)
+
+
+@pytest.mark.parametrize("angle, bevelled", [(61.0, False), (59.0, True)])
+def test_corners_sharper_than_60_degrees_are_bevelled(angle, bevelled):
+    # a fan: the corner at the origin, its bisector along +x; the arc's corners are blunt
+    half = math.radians(angle / 2)
+    arc = [(20 * math.cos(a), 20 * math.sin(a)) for a in np.linspace(-half, half, 5)]
+    mesh = roof_mesh(np.array([(0.0, 0.0), *arc]), "hip", PITCH, 0.5)
+    assert any(p.kind == "corner" for p in mesh.planes) == bevelled
+    # a mitre reaches overhang / sin(angle / 2) along the bisector; a bevel the overhang
+    tip = -mesh.eave[:, 0].min()
+    assert tip == pytest.approx(0.5 if bevelled else 0.5 / math.sin(half), rel=1e-9)
+
+
+def test_a_triangle_gets_no_gable():
+    poly = np.array(SHARP["triangle"], dtype=float)
+    mesh = roof_mesh(poly, "gable", PITCH)
+    assert mesh.kind == "gable" and not mesh.fallback
+    assert not any(p.kind == "gable" for p in mesh.planes)
+    assert capped(mesh).volume == pytest.approx(capped(roof_mesh(poly, "hip", PITCH)).volume)
+
+
+def test_pyramid_overhang_is_bounded_on_a_long_footprint():
+    # a square: every eave overhang out, level (the pyramid grown about its apex)
+    square = np.array([(0, 0), (8, 0), (8, 8), (0, 8)], dtype=float)
+    mesh = roof_mesh(square, "pyramid", PITCH, 0.5)
+    assert np.allclose(mesh.eave[:, 2], -0.5 * TAN)
+    assert np.allclose(np.abs(mesh.eave[:, :2] - 4), 4.5)
+    # 6 m x 70 m: the far corners stop at MITRE_LIMIT overhangs (carried on by the overhang
+    # over the apex's clearance, they went 5.85 m out); the planes stay those without overhang
+    long = np.array([(0, 0), (70, 0), (70, 6), (0, 6)], dtype=float)
+    base, mesh = roof_mesh(long, "pyramid", PITCH), roof_mesh(long, "pyramid", PITCH, 0.5)
+    moved = np.linalg.norm(mesh.eave[:, :2] - long, axis=1)
+    assert moved == pytest.approx(np.full(4, MITRE_LIMIT * 0.5))
+    for p, q in zip(base.planes, mesh.planes, strict=True):
+        assert np.allclose(p.normal, q.normal) and p.offset == pytest.approx(q.offset)
+    solid = capped(mesh)
+    assert solid.is_watertight and solid.volume > capped(base).volume

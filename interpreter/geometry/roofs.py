@@ -19,9 +19,9 @@ Kinds
     until they meet the wall: the wall's face is a vertical triangle in the wall's plane.  A convex
     quadrilateral whose hip roof has no ridge (a square) gets gables on the two edges beside its
     front edge (``polygon[0] -> polygon[1]``), so the ridge runs parallel to the front.  Shapes
-    with no wing end (a regular hexagon) keep their hip roof.  A gable whose wall would not stay
-    a wall in the eave polygon (next to a reflex corner there, once an overhang has closed a
-    notch) is made a slope again, rising from the eave.
+    with no wing end (a regular hexagon, a triangle) keep their hip roof.  A gable whose wall
+    would not stay a wall in the eave polygon (next to a reflex corner there, once an overhang
+    has closed a notch) is made a slope again, rising from the eave.
 ``pyramid``
     One apex, one triangle per edge.  The apex is above the centroid or the pole of
     inaccessibility, whichever is farther from the boundary (the centroid on a tie), among those
@@ -51,12 +51,28 @@ edge at z = 0, and the eave ends ``overhang * tan(p)`` lower (for a mansard or g
 the lower band's pitch); gable walls do not move, so a gable end has no overhang.  For the
 skeleton kinds the roof is the skeleton of the *eave polygon* — the footprint grown outward by the
 overhang (mitred corners; gable walls stay in their plane) — lowered by that amount; a shed and a
-flat roof cover the same eave polygon; a pyramid is extended about its apex so that every eave is
-at ``-overhang * tan(pitch)`` (its eaves reach at least ``overhang`` out).  The eave polygon is
-grown by the outward wavefront with its events, so an overhang wider than a small indent closes
-it, and one that would make opposite eaves meet across a narrow courtyard covers it; there the
-eave polygon has lost edges and the roof near them is the roof of the grown shape rather than an
-extension of the roof without overhang.
+flat roof cover the same eave polygon.  The eave polygon is grown by the outward wavefront with
+its events, so an overhang wider than a small indent closes it, and one that would make opposite
+eaves meet across a narrow courtyard covers it; there the eave polygon has lost edges and the roof
+near them is the roof of the grown shape rather than an extension of the roof without overhang.
+
+A mitre reaches ``overhang / sin(angle / 2)`` from a corner of that angle: a corner of a few
+degrees (a needle left on a footprint by a digitising slip) would send the eave hundreds of metres
+away.  So a convex corner sharper than 60 degrees, whose mitre would reach more than
+``MITRE_LIMIT`` (2) overhangs, is *bevelled*: the eave polygon gets an edge ``overhang`` beyond the
+corner, square to its bisector, from which a ``corner`` plane rises at the roof's pitch through
+the corner itself (a small hip facet; without an overhang it has no size and no corner is
+bevelled).  A gable wall next to such a corner becomes a slope when there is an overhang.  So no
+eave corner is more than ``MITRE_LIMIT * overhang`` from its footprint corner.
+
+A pyramid keeps its planes too: each hip (from the apex through a corner) is carried on past its
+corner until the eave is ``overhang`` beyond the nearer of the corner's two walls, but not more than
+``MITRE_LIMIT * overhang`` from the corner; each eave corner is as low as its hip takes it.  On a
+regular footprint every corner goes the same way (the eave is level at ``-overhang * tan(pitch)``,
+every eave ``overhang`` out); on a long one the limit holds the far corners back, so the walls
+nearest the apex get less than ``overhang`` and the eave slopes.  (Carrying every hip on by
+``overhang`` over the apex's clearance, as before, gave a 6 m x 70 m footprint 5.8 m eaves at its
+ends for a 0.5 m overhang, and a needle eaves of two kilometres.)
 
 Output
 ------
@@ -69,7 +85,6 @@ Every kind but ``flat`` is a closed surface once a cap on ``eave`` (facing down)
 from __future__ import annotations
 
 import math
-import warnings
 from dataclasses import dataclass
 
 import numpy as np
@@ -82,6 +97,7 @@ from .skeleton import Skeleton, SkeletonError, edge_lines, offset_outward, strai
 KINDS = ("flat", "gable", "hip", "pyramid", "shed", "mansard", "gambrel")
 MANSARD_BREAK = 1.0 / 3.0  # the steep lower band covers this fraction of the largest inset
 _CLEAN_TOL = 2e-6  # relative: corners closer than this, or this close to straight, are dropped
+MITRE_LIMIT = 2.0  # an eave corner reaches at most this many overhangs from its footprint corner
 
 
 def mansard_lower_pitch(pitch: float) -> float:
@@ -93,10 +109,12 @@ def mansard_lower_pitch(pitch: float) -> float:
 class RoofPlane:
     """One plane of a roof: the points p with ``normal . p == offset``.
 
-    ``kind`` is ``slope`` (rising from an edge), ``gable`` (a vertical gable wall), ``wall`` (a
-    shed's vertical side) or ``flat``.  ``edge`` is the index i of the footprint edge
-    ``polygon[i] -> polygon[i+1]`` the plane rises from or stands on (None for a flat roof);
-    ``edges`` all the input edges on that line (collinear runs and repeated points are merged).
+    ``kind`` is ``slope`` (rising from an edge), ``corner`` (rising from a sharp corner whose
+    eave is bevelled), ``gable`` (a vertical gable wall), ``wall`` (a shed's vertical side) or
+    ``flat``.  ``edge`` is the index i of the footprint edge ``polygon[i] -> polygon[i+1]`` the
+    plane rises from or stands on (None for a flat roof and a corner); ``edges`` all the input
+    edges on that line (collinear runs and repeated points are merged), for a corner the two
+    edges that meet there.
     ``normal`` points outward (up for a slope); ``pitch`` is in degrees from horizontal.
     """
 
@@ -119,6 +137,7 @@ class RoofMesh:
     eave: np.ndarray  # (E, 3): the outline of the open bottom, counter-clockwise from above
     overhang: float
     kind: str  # the kind built (a pyramid that cannot be built is a hip)
+    fallback: str = ""  # why the kind built is not the kind asked for, when that is a surprise
 
 
 def roof_mesh(polygon, kind: str, pitch: float, overhang: float = 0.0) -> RoofMesh:
@@ -186,6 +205,25 @@ class _Footprint:
             scale=scale,
         )
 
+    def line(self, k: int) -> tuple[np.ndarray, np.ndarray]:
+        """The inward unit normal of line k and a point on it: edge k, or for ``k >= n`` the
+        bevel of corner ``k - n`` (see :func:`_eave_ring`): through the corner, its normal
+        halfway between those of the corner's two edges."""
+        _, nrm, _ = edge_lines(self.points)
+        n = len(self.points)
+        if k < n:
+            return nrm[k], self.points[k]
+        j = k - n
+        return _unit(nrm[j - 1] + nrm[j]), self.points[j]
+
+    def naming(self, k: int, kind: str = "slope") -> tuple[str, int | None, tuple[int, ...]]:
+        """``(kind, edge, edges)`` of a RoofPlane on line k (see :meth:`line`)."""
+        n = len(self.points)
+        if k < n:
+            return kind, self.label[k], self.edges[k]
+        j = k - n
+        return "corner", None, (self.label[j - 1], self.label[j])
+
 
 def _essential_corners(pts: np.ndarray, runs: list, tol: float):
     """Drop the corners of a ring that are within ``tol`` of the previous one or of the straight
@@ -213,10 +251,65 @@ def _cross(u, v):
     return u[..., 0] * v[..., 1] - u[..., 1] * v[..., 0]
 
 
+def _sharp_corners(pts: np.ndarray, weights: np.ndarray) -> list[int]:
+    """The convex corners between two moving edges whose mitre would reach more than
+    MITRE_LIMIT overhangs: interior angle theta with sin(theta / 2) < 1 / MITRE_LIMIT."""
+    d, _, _ = edge_lines(pts)
+    before = np.roll(d, 1, axis=0)  # the edge into corner j
+    convex = _cross(before, d) > 0
+    sharp = np.einsum("ij,ij->i", before, d) < 2.0 / MITRE_LIMIT**2 - 1.0
+    moving = (weights > 0) & (np.roll(weights, 1) > 0)
+    return [int(j) for j in np.flatnonzero(convex & sharp & moving)]
+
+
+def _bevelled(pts: np.ndarray, weights: np.ndarray, sharp: list[int], overhang: float):
+    """The polygon whose outward offset by ``overhang`` is the bevelled eave of ``pts``: each
+    sharp corner cut by a short chamfer that moves out fast enough (its speed) to end at distance
+    ``overhang`` beyond the corner.  Returns the points, the edges' speeds and, per edge, its
+    line (footprint edge k, or ``n + j`` for the chamfer of corner j)."""
+    n = len(pts)
+    if not sharp:
+        return pts, weights, np.arange(n)
+    lengths = np.linalg.norm(np.roll(pts, -1, axis=0) - pts, axis=1)
+    d, _, _ = edge_lines(pts)
+    cuts = np.minimum(overhang, 0.25 * np.minimum(lengths, np.roll(lengths, 1)))
+    for _ in range(8):  # cuts small enough that the chamfered polygon stays simple
+        points, speed, lines = [], [], []
+        for j in range(n):
+            if j in sharp:
+                cut = float(cuts[j])
+                a, b = pts[j] - cut * d[j - 1], pts[j] + cut * d[j]
+                inset = float(np.linalg.norm(d[j] - d[j - 1])) * cut / 2.0  # corner to chamfer
+                points += [a, b]
+                speed += [1.0 + inset / overhang, weights[j]]
+                lines += [n + j, j]
+            else:
+                points.append(pts[j])
+                speed.append(weights[j])
+                lines.append(j)
+        points = np.array(points)
+        if Polygon(points).is_valid:
+            return points, np.array(speed), np.array(lines, dtype=np.int64)
+        cuts /= 8.0
+    raise ValueError("a roof footprint with corners too sharp to bevel")
+
+
 def _eave_ring(fp: _Footprint, overhang: float, weights: np.ndarray):
-    """The eave polygon (see the module docstring) and, for each of its edges, the footprint
-    edge whose plane it carries."""
-    ring, source = offset_outward(fp.points, overhang, weights)
+    """The eave polygon (see the module docstring) and, for each of its edges, the line whose
+    plane it carries: footprint edge k, or ``n + j`` for the bevel of corner j.
+
+    A mitred corner reaches ``overhang / sin(angle / 2)`` from its footprint corner: without a
+    limit, a corner of a few degrees (a needle that a digitising slip left on a footprint) sends
+    the eave hundreds of metres away.  So a convex corner whose mitre would reach more than
+    MITRE_LIMIT overhangs (one sharper than 60 degrees) is bevelled: the eave gets an edge at
+    distance ``overhang`` from the corner, square to the corner's bisector, and the roof a
+    *corner* plane rising from it at the roof's pitch through the corner itself, so the roof
+    still sits on the corner.  (Without an overhang a corner needs no bevel.)
+    """
+    sharp = _sharp_corners(fp.points, weights) if overhang > 0 else []
+    poly, speed, lines = _bevelled(fp.points, weights, sharp, overhang)
+    ring, source = offset_outward(poly, overhang, speed)
+    source = lines[source]
     keep, runs = _essential_corners(ring, [(q,) for q in range(len(ring))], _CLEAN_TOL * fp.scale)
     if len(keep) < 3:
         raise ValueError("the roof's eave polygon collapsed")
@@ -288,25 +381,21 @@ def _unit(v) -> np.ndarray:
 def _slope_plane(
     fp: _Footprint, k: int, tan: float, start: float = 0.0, base: float = 0.0
 ) -> RoofPlane:
-    """The plane over edge k that is at height ``base`` at inset ``start`` and rises at ``tan``."""
-    _, nrm, _ = edge_lines(fp.points)
-    normal = _unit([-tan * nrm[k][0], -tan * nrm[k][1], 1.0])
-    point = np.append(fp.points[k] + start * nrm[k], base)
-    return RoofPlane(
-        "slope",
-        fp.label[k],
-        fp.edges[k],
-        normal,
-        float(normal @ point),
-        math.degrees(math.atan(tan)),
-    )
+    """The plane over line k (an edge, or a bevelled corner: :meth:`_Footprint.line`) that is at
+    height ``base`` at inset ``start`` and rises at ``tan``."""
+    nrm, origin = fp.line(k)
+    normal = _unit([-tan * nrm[0], -tan * nrm[1], 1.0])
+    point = np.append(origin + start * nrm, base)
+    kind, edge, edges = fp.naming(k)
+    return RoofPlane(kind, edge, edges, normal, float(normal @ point), math.degrees(math.atan(tan)))
 
 
 def _wall_plane(fp: _Footprint, k: int, kind: str, through) -> RoofPlane:
-    """The vertical plane along edge k through the point ``through`` (2D), facing outward."""
-    _, nrm, _ = edge_lines(fp.points)
-    normal = np.array([-nrm[k][0], -nrm[k][1], 0.0])
-    return RoofPlane(kind, fp.label[k], fp.edges[k], normal, float(normal[:2] @ through), 90.0)
+    """The vertical plane along line k through the point ``through`` (2D), facing outward."""
+    nrm, _ = fp.line(k)
+    normal = np.array([-nrm[0], -nrm[1], 0.0])
+    _, edge, edges = fp.naming(k, kind)
+    return RoofPlane(kind, edge, edges, normal, float(normal[:2] @ through), 90.0)
 
 
 # --------------------------------------------------------------------------------------------
@@ -316,10 +405,15 @@ def _wall_plane(fp: _Footprint, k: int, kind: str, through) -> RoofPlane:
 def _skeleton_roof(fp: _Footprint, kind: str, pitch: float, overhang: float) -> RoofMesh:
     """Lift the (weighted, possibly staged) straight skeleton of the eave polygon."""
     pts = fp.points
+    n = len(pts)
     hip = straight_skeleton(pts)
-    weights = np.ones(len(pts))
+    weights = np.ones(n)
     if kind in ("gable", "gambrel"):
         weights[_gable_edges(fp, hip)] = 0.0
+        if overhang > 0:  # a sharp corner is bevelled (see _eave_ring): no gable wall beside it
+            for j in _sharp_corners(pts, np.ones(n)):
+                weights[[j - 1, j]] = 1.0
+    line_weights = np.concatenate([weights, np.ones(n)])  # a bevelled corner is a slope
     two_slopes = kind in ("mansard", "gambrel")
     pitches = (mansard_lower_pitch(pitch), pitch) if two_slopes else (pitch,)
     tans = [math.tan(math.radians(p)) for p in pitches]
@@ -331,12 +425,13 @@ def _skeleton_roof(fp: _Footprint, kind: str, pitch: float, overhang: float) -> 
             eave, source, speed, sk = pts, np.arange(len(pts)), weights, hip
         else:
             eave, source = _eave_ring(fp, overhang, weights)
-            speed, sk = _gabled_skeleton(eave, weights[source], breaks)
+            speed, sk = _gabled_skeleton(eave, line_weights[source], breaks)
     except SkeletonError as exc:
         if weights.all():
             raise
-        warnings.warn(f"gable ends dropped ({exc}); building a hip roof", stacklevel=3)
-        return _skeleton_roof(fp, "mansard" if two_slopes else "hip", pitch, overhang)
+        mesh = _skeleton_roof(fp, "mansard" if two_slopes else "hip", pitch, overhang)
+        mesh.fallback = f"its gable ends could not be built ({exc})"
+        return mesh
 
     t = sk.nodes[:, 2]
     z = tans[0] * (t - overhang)
@@ -352,7 +447,7 @@ def _skeleton_roof(fp: _Footprint, kind: str, pitch: float, overhang: float) -> 
             if speed[k] > 0:
                 # an eave edge grown by the overhang rises from its wall top at z = 0; a gable
                 # that had to become a slope rises from the eave height instead
-                lower = overhang - overhang * weights[edge]
+                lower = overhang - overhang * line_weights[edge]
                 plane = builder.plane(
                     ("slope", edge, stage, lower),
                     _slope_plane,
@@ -420,9 +515,13 @@ def _gable_edges(fp: _Footprint, hip: Skeleton) -> list[int]:
         apex = [v for v in corners if v not in (k, (k + 1) % n)]
         if len(corners) != 3 or len(apex) != 1:
             continue
+        # a ridge: a segment between two skeleton nodes that both neighbouring slopes share;
+        # in a triangle those slopes also share the hip from their common corner (node < n),
+        # which is no ridge
         shared = sides[k - 1] & sides[(k + 1) % n]
         if any(
-            apex[0] in s and np.linalg.norm(np.subtract(*xy[list(s)])) > min_ridge for s in shared
+            apex[0] in s and min(s) >= n and np.linalg.norm(np.subtract(*xy[list(s)])) > min_ridge
+            for s in shared
         ):
             chosen.append(k)
     if not chosen and n == 4 and convex.all():
@@ -496,17 +595,31 @@ def _clip_half_plane(poly, normal, level):
     return out
 
 
+def _pyramid_growth(pts: np.ndarray, apex: np.ndarray, run: np.ndarray, overhang: float):
+    """How far each corner's hip is carried on past the corner, as a fraction of the corner's
+    distance from the apex: until the eave is ``overhang`` beyond the nearer of the corner's two
+    walls (``run``: the apex's distance from each edge's line), but no more than MITRE_LIMIT
+    overhangs from the corner.  The old single fraction, ``overhang`` over the apex's clearance,
+    gave a 6 m x 70 m footprint 5.8 m eaves at its ends for 0.5 m, and a needle kilometres."""
+    if overhang == 0:
+        return np.zeros(len(pts))
+    nearer = np.minimum(run, np.roll(run, 1))  # corner j is between edges j-1 and j
+    reach = np.linalg.norm(pts - apex, axis=1)
+    return np.minimum(overhang / nearer, MITRE_LIMIT * overhang / reach)
+
+
 def _pyramid_roof(fp: _Footprint, pitch: float, overhang: float, apex: np.ndarray) -> RoofMesh:
-    """One triangle per edge up to the apex; with overhang, the pyramid extended about its apex."""
+    """One triangle per edge up to the apex; with overhang, each hip carried on past its corner
+    (see ``pyramid`` in the module docstring), so that every face keeps its plane."""
     pts = fp.points
     n = len(pts)
     radius = Polygon(pts).exterior.distance(Point(apex))
     tan = math.tan(math.radians(pitch))
     height = tan * radius
-    grow = overhang / radius
-    eave = np.column_stack([apex + (1.0 + grow) * (pts - apex), np.full(n, -grow * height)])
-    builder = _MeshBuilder(np.vstack([eave, [[apex[0], apex[1], height]]]))
     _, nrm, c = edge_lines(pts)
+    grow = _pyramid_growth(pts, apex, nrm @ apex - c, overhang)
+    eave = np.column_stack([pts + grow[:, None] * (pts - apex), -grow * height])
+    builder = _MeshBuilder(np.vstack([eave, [[apex[0], apex[1], height]]]))
     for k in range(n):
         a, b = np.append(pts[k], 0.0), np.append(pts[(k + 1) % n], 0.0)
         normal = _unit(np.cross(b - a, np.append(apex, height) - a))

@@ -8,6 +8,7 @@ from ..expressions import runtime_error
 from ..geometry.meshes import PLANE_AXES, clip_below
 from ..geometry.polygons import RECT, UNIT_SQUARE, metric
 from ..geometry.rect_roofs import rectangle_hip
+from ..geometry.skeleton import SkeletonError
 from ..shapes import Flat, Solid
 from ..terminals import UnitMesh
 
@@ -35,7 +36,6 @@ def roof(app, shape, step, args) -> bool:
         raise runtime_error(
             app.module, step.pos, f"a negative overhang ({overhang:g}) is not a roof"
         )
-    from ..geometry.roofs import roof_mesh
     from .components import _into_extrusion_frame
 
     if geom.k != 1:
@@ -53,12 +53,7 @@ def roof(app, shape, step, args) -> bool:
         faces.append(f)
         polys = []
     for ext, _holes in metric(polys, shape.size[p], shape.size[q]):
-        try:
-            m = roof_mesh(np.asarray(ext, dtype=float), kind, float(pitch), float(overhang))
-        except ValueError as e:  # a footprint the roof builder cannot use (not simple, degenerate)
-            raise runtime_error(
-                app.module, step.pos, f"cannot build a {kind} roof on this footprint: {e}"
-            ) from None
+        m = _mesh(app, step, np.asarray(ext, dtype=float), kind, float(pitch), float(overhang))
         walls = np.array([m.planes[i].kind in ("gable", "wall") for i in m.face_plane], dtype=bool)
         m_vertices, m_faces = (
             clip_below(m.vertices, m.faces, walls)
@@ -85,3 +80,31 @@ def roof(app, shape, step, args) -> bool:
     shape.size = extent.tolist()
     shape.geom = Solid(app.engine.table.library.add(UnitMesh("roof", unit, tris)), "roof")
     return False
+
+
+def _mesh(app, step, polygon: np.ndarray, kind: str, pitch: float, overhang: float):
+    """The roof mesh, or a located error for a footprint the builder cannot use (not simple,
+    degenerate).  Where the kind asked for could not be built and another was (a gable whose
+    ends failed), or the straight skeleton gave up on a footprint (it should not; a flat roof
+    then stands in), the run goes on with a warning that names the lot and the grammar's place.
+    """
+    from ..geometry.roofs import roof_mesh
+
+    try:
+        mesh = roof_mesh(polygon, kind, pitch, overhang)
+    except ValueError as e:
+        raise runtime_error(
+            app.module, step.pos, f"cannot build a {kind} roof on this footprint: {e}"
+        ) from None
+    except SkeletonError as e:
+        app.engine.warn(
+            app.module, step.pos, f"cannot build a {kind} roof on this footprint ({e}); built flat"
+        )
+        return roof_mesh(polygon, "flat", pitch, overhang)
+    if mesh.fallback:
+        app.engine.warn(
+            app.module,
+            step.pos,
+            f"{mesh.fallback}: built a {mesh.kind} roof instead of a {kind} roof",
+        )
+    return mesh
