@@ -148,6 +148,9 @@ def build_parser() -> argparse.ArgumentParser:
     render.add_argument(
         "--max-shapes", type=int, default=10_000_000, metavar="N", help="shape budget (10,000,000)"
     )
+    render.add_argument(
+        "--strict", action="store_true", help="treat a .bgr's warnings as errors, as for derive"
+    )
 
     infer = commands.add_parser(
         "infer",
@@ -399,8 +402,12 @@ def cmd_render(args) -> int:
     if args.legend and args.mode != "labels":
         return usage("--legend goes with --mode labels")
     is_grammar = Path(args.file).suffix.lower() == ".bgr"
-    if not is_grammar and (args.seed is not None or args.set or args.lot is not None):
-        return usage("--seed, --set and --lot apply to a .bgr grammar, not to a model file")
+    if not is_grammar and (
+        args.seed is not None or args.set or args.lot is not None or args.strict
+    ):
+        return usage(
+            "--seed, --set, --lot and --strict apply to a .bgr grammar, not to a model file"
+        )
     if args.max_depth < 1 or args.max_shapes < 1:
         return usage("--max-depth and --max-shapes must be positive")
     attrs = {}
@@ -425,7 +432,10 @@ def cmd_render(args) -> int:
         lot=args.lot,
         max_depth=args.max_depth,
         max_shapes=args.max_shapes,
+        strict=args.strict,
     )
+    for warning in scene.warnings:
+        print(warning.render(), file=sys.stderr)
     camera = make_camera(args.view, scene, size)
 
     def fallback(reason: str) -> None:

@@ -19,7 +19,7 @@ triangles came from.
 from __future__ import annotations
 
 import os
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
@@ -39,6 +39,8 @@ class Scene:
     part: np.ndarray  # (T,) int64
     label: np.ndarray  # (T,) int64 index into labels
     labels: list[str]
+    # a derived grammar's warnings (footprints skipped or repaired, ...): bgr.Result.warnings
+    warnings: list = field(default_factory=list)
 
     def __len__(self) -> int:
         return len(self.triangles)
@@ -82,6 +84,7 @@ def from_result(result: Any) -> Scene:
         part=row,
         label=label_of_row[row],
         labels=labels,
+        warnings=list(getattr(result, "warnings", [])),
     )
 
 
@@ -196,9 +199,11 @@ def load_scene(
     lot: Any = None,
     max_depth: int | None = None,
     max_shapes: int | None = None,
+    strict: bool = False,
 ) -> Scene:
     """A :class:`Scene` from a Scene, a ``bgr.Result``, a terminal table, a trimesh, or a path to
-    a ``.bgr`` (derived with ``seed``, ``attrs`` and ``lot``), ``.glb`` or ``.gltf`` file."""
+    a ``.bgr`` (derived with ``seed``, ``attrs``, ``lot`` and ``strict``, its warnings kept in
+    ``Scene.warnings``), ``.glb`` or ``.gltf`` file."""
     if isinstance(source, Scene):
         return source
     if isinstance(source, (str, os.PathLike)):
@@ -214,7 +219,8 @@ def load_scene(
                 if v is not None
             }
             grammar = load(path, path=str(source))
-            return from_result(derive(grammar, seed=seed, attrs=attrs, lot=lot, **limits))
+            result = derive(grammar, seed=seed, attrs=attrs, lot=lot, strict=strict, **limits)
+            return from_result(result)
         if suffix in (".glb", ".gltf"):
             return from_gltf(path)
         raise BgrError(

@@ -412,3 +412,18 @@ def test_helsinki_roofs_stay_over_their_footprints(helsinki, kind):
         assert reach <= MITRE_LIMIT * overhang + height + 1e-6, (lot.name, reach, height)
         if kind not in ("flat", "pyramid"):  # the bound as the issue states it, for slopes
             assert reach <= overhang + height + 1e-6, (lot.name, reach, height)
+
+
+def test_render_prints_the_warnings_of_a_grammar(tmp_path):
+    geo = write(tmp_path, feature([square(0, 0)], {"id": 1}), feature(None, {"id": 2}))
+    src = tmp_path / "box.bgr"
+    src.write_text(BOX)
+    out = tmp_path / "x.png"
+    args = ("render", src, "--lot", geo, "-o", out, "--backend", "numpy", "--size", "64x48")
+    proc = bgr_cli(*args)
+    assert proc.returncode == 0, proc.stderr
+    assert f"{geo}: warning: feature 1 (id 2) skipped: it has no geometry" in proc.stderr
+    assert bgr_cli(*args, "--strict").returncode == 1
+    model = tmp_path / "x.glb"
+    assert bgr_cli("derive", src, "-o", model).returncode == 0
+    assert bgr_cli("render", model, "-o", out, "--strict").returncode == 2
