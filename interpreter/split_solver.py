@@ -133,7 +133,7 @@ def _resolve(items: list[Item], length: float) -> list[tuple[Item, float]]:
             for _ in range(counts[id(item)]):
                 sized.append((item, a + f * scale))
     if groups and all(_nominal(g, length)[1] <= 0 for g in groups) and float_out <= 0:
-        sized = _fill_remainder(sized, groups, avail, length)
+        sized = _fill_remainder(sized, items, groups, avail)
     return sized
 
 
@@ -178,9 +178,10 @@ def _repetitions(groups: list[Repeat], avail: float, float_out: float, length: f
     return {id(g): c for g, c in zip(groups, counts, strict=True)}, s
 
 
-def _fill_remainder(sized, groups, avail, length):
+def _fill_remainder(sized, items, groups, avail):
     """Absolute repeats: after the whole repetitions, one more repetition cut at the end of the
-    room the groups have (rule 4), so `{ 3: A }*` in 10 gives A 3, A 3, A 3, A 1."""
+    room the groups have (rule 4), so `{ 3: A }*` in 10 gives A 3, A 3, A 3, A 1, and a tile
+    longer than its scope (`{ 30: A }*` in 10) gives one A cut to 10."""
     used = sum(size for item, size in sized if isinstance(item, Repeat))
     left = avail - used
     if left <= EPS:
@@ -191,13 +192,11 @@ def _fill_remainder(sized, groups, avail, length):
         else None
     )
     group = groups[-1] if last is None else sized[last][0]
-    insert_at = (
-        (last + 1)
-        if last is not None
-        else next(i for i, (it, _) in enumerate(sized) if it is group) + 0
-    )
-    if last is None:  # no whole repetition fitted: the group's only repetition is the cut one
-        sized = [(it, sz) for it, sz in sized if it is not group or sz > 0]
+    if last is not None:
+        insert_at = last + 1
+    else:  # no whole repetition fitted anywhere: the cut one stands where the group is written
+        before = items[: next(i for i, it in enumerate(items) if it is group)]
+        insert_at = sum(1 for it in before if isinstance(it, Piece))
     return sized[:insert_at] + [(_Cut(group, left), left)] + sized[insert_at:]
 
 

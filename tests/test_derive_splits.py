@@ -117,3 +117,32 @@ def test_absolute_sizes_overflowing_leave_floats_nothing():
     assert [
         (p.payload, p.size) for p in solve([Piece("abs", 12, "A"), Piece("float", 1, "B")], 10)
     ] == [("A", 10)]
+
+
+@pytest.mark.parametrize(
+    "src, lot, expected",
+    [
+        # a repeat tile longer than its scope: one repetition, cut to the scope (rule 4)
+        ("Lot --> split(x) { 30: T }*\nterminal T\n", (20, 20), [("T", 20.0, 0.0)]),
+        (
+            "Lot --> split(x) { 1: A | { 30: T }* | 2: B }\nterminal T, A, B\n",
+            (20, 20),
+            [("A", 1.0, 0.0), ("T", 17.0, 1.0), ("B", 2.0, 18.0)],
+        ),
+    ],
+)
+def test_a_repeat_tile_longer_than_its_scope_is_cut_not_a_crash(src, lot, expected):
+    t = bgr.derive(bgr.load(src), lot=lot).terminals
+    got = [
+        (lab, float(s[0]), float(o[0])) for lab, s, o in zip(t.label, t.size, t.origin, strict=True)
+    ]
+    assert got == [(lab, pytest.approx(s), pytest.approx(o)) for lab, s, o in expected]
+
+
+def test_a_repeat_tile_longer_than_a_face_is_cut():
+    src = (
+        "Lot --> s(2, 0, 2) extrude(3) comp(f) { side: split(x) { 3: T }* | all: NIL }\n"
+        "terminal T\n"
+    )
+    t = bgr.derive(bgr.load(src)).terminals
+    assert len(t) == 4 and all(s[0] == pytest.approx(2.0) for s in t.size)
