@@ -48,15 +48,33 @@ class SplitError(ValueError):
     """A size the solver cannot use (not finite); the interpreter reports it at the split."""
 
 
-def solve(items: list[Item] | tuple[Item, ...], length: float) -> list[Placed]:
-    """Place the pieces of a split of ``length``; see LANGUAGE.md section 6."""
+def solve(
+    items: list[Item] | tuple[Item, ...], length: float, limit: int | None = None
+) -> list[Placed]:
+    """Place the pieces of a split of ``length``; see LANGUAGE.md section 6.
+
+    ``limit`` bounds the number of pieces: the repetitions are counted before any is laid out,
+    so a runaway repeat (``{ 0.001: A }*`` on 10 km) is a SplitError at once, not gigabytes of
+    pieces made first and counted afterwards.
+    """
     for piece in _pieces(items):
         if not math.isfinite(piece.size):
             raise SplitError(f"a split size is {piece.size}")
-    sized = _resolve([_to_absolute(it, length) for it in items], length)
+    limit = _NO_LIMIT if limit is None else max(int(limit), 0)
+    sized = _resolve([_to_absolute(it, length) for it in items], length, limit)
     out: list[Placed] = []
-    _lay_out(sized, 0.0, length, out)
+    _lay_out(sized, 0.0, length, out, limit)
     return out
+
+
+_NO_LIMIT = 1 << 62
+
+
+def _too_many(count: int, limit: int) -> SplitError:
+    return SplitError(
+        f"this split would make {count:,} pieces, more than {limit:,} shapes (what the shape "
+        "budget has left)"
+    )
 
 
 def _pieces(items):
@@ -103,7 +121,7 @@ def _nominal(group: Repeat, length: float) -> tuple[float, float]:
     return a, f
 
 
-def _resolve(items: list[Item], length: float) -> list[tuple[Item, float]]:
+def _resolve(items: list[Item], length: float, limit: int = _NO_LIMIT) -> list[tuple[Item, float]]:
     """Every item of one level with its final size (a group is expanded into its repetitions)."""
     groups = [it for it in items if isinstance(it, Repeat)]
     abs_out = sum(
@@ -121,6 +139,11 @@ def _resolve(items: list[Item], length: float) -> list[tuple[Item, float]]:
     scale = 1.0
     if groups:
         counts, scale = _repetitions(groups, avail, float_out, length)
+        pieces = sum(1 for it in items if isinstance(it, Piece)) + sum(
+            counts[id(g)] * max(len(g.items), 1) for g in groups
+        )
+        if pieces > limit:
+            raise _too_many(pieces, limit)
     elif float_out > 0:
         scale = max(avail, 0.0) / float_out
     sized: list[tuple[Item, float]] = []
@@ -211,23 +234,25 @@ class _Cut:
 # ---- steps 4-6: placing -------------------------------------------------------------------------
 
 
-def _lay_out(sized, start: float, end: float, out: list[Placed]) -> float:
+def _lay_out(sized, start: float, end: float, out: list[Placed], limit: int = _NO_LIMIT) -> float:
     """Place items from ``start``; pieces overflowing ``end`` are cut, later ones not created."""
     at = start
     for item, size in sized:
         if at >= end - EPS:
             break
         if isinstance(item, _Cut):
-            _lay_out(_resolve_cut(item.group), at, min(at + item.room, end), out)
+            _lay_out(_resolve_cut(item.group), at, min(at + item.room, end), out, limit)
             at = min(at + item.room, end)
             continue
         if size <= EPS:
             continue
         size = min(size, end - at)
         if isinstance(item, Repeat):
-            inner = _resolve(list(item.items), size)
-            _lay_out(inner, at, at + size, out)
+            inner = _resolve(list(item.items), size, limit - len(out))
+            _lay_out(inner, at, at + size, out, limit)
         else:
+            if len(out) >= limit:
+                raise _too_many(len(out) + 1, limit)
             out.append(Placed(item.payload, at, size))
         at += size
     return at

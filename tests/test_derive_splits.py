@@ -146,3 +146,22 @@ def test_a_repeat_tile_longer_than_a_face_is_cut():
     )
     t = bgr.derive(bgr.load(src)).terminals
     assert len(t) == 4 and all(s[0] == pytest.approx(2.0) for s in t.size)
+
+
+@pytest.mark.parametrize("size", ["0.001", "~0.001", "'0.0000001"])
+def test_a_runaway_repeat_is_counted_before_it_is_built(size):
+    """10 million pieces asked of a budget of 1,000: refused at once, before any is made."""
+    import time
+
+    src = f"Lot --> split(x) {{ {size}: T }}*\nterminal T\n"
+    start = time.perf_counter()
+    with pytest.raises(bgr.BgrError, match="would make 10,000,000 pieces") as e:
+        bgr.derive(bgr.load(src), lot=(10000, 10), max_shapes=1000)
+    assert time.perf_counter() - start < 2.0
+    assert (e.value.line, e.value.column) == (1, 9)
+
+
+def test_nested_repeats_are_counted_too():
+    src = "Lot --> split(x) { { 1: split(z) { 0.01: T }* }* }\nterminal T\n"
+    with pytest.raises(bgr.BgrError, match="would make"):
+        bgr.derive(bgr.load(src), lot=(1000, 1000), max_shapes=5000)

@@ -15,7 +15,7 @@ from ..expressions import runtime_error
 from ..geometry.meshes import PLANE_AXES
 from ..geometry.polygons import RECT, clip, renormalise
 from ..shapes import Prism, Solid
-from ..split_solver import Piece, Repeat, solve
+from ..split_solver import Piece, Repeat, SplitError, solve
 
 
 def _sizes(app, entries) -> tuple:
@@ -78,7 +78,16 @@ def split(app, shape, step, args) -> bool:
         items = _items(step.block.entries, sizes)
         if step.block.repeat:
             items = (Repeat(items),)
-        placed = solve(items, length)
+        engine = app.engine
+        try:
+            placed = solve(items, length, limit=engine.max_shapes - engine.shapes)
+        except SplitError as e:
+            raise runtime_error(
+                app.module,
+                step.pos,
+                str(e),
+                "make the pieces larger, or raise the budget with --max-shapes",
+            ) from None
         if len(cache) > 100_000:
             cache.clear()
         cache[key] = placed
