@@ -9,6 +9,7 @@ traceback only when BGR_DEBUG=1.
 from __future__ import annotations
 
 import argparse
+import contextlib
 import os
 import sys
 import tempfile
@@ -20,6 +21,14 @@ from .grammar.errors import BgrError, Diagnostic
 from .grammar.formatter import format_module
 from .grammar.loader import decode, load, read_source
 from .grammar.parser import parse
+from .interpreter.limits import (
+    DEFAULT_MAX_DEPTH,
+    DEFAULT_MAX_SHAPES,
+    DEFAULT_MAX_TRIANGLES,
+    default_max_memory,
+    format_bytes,
+    parse_memory,
+)
 
 EXIT_OK, EXIT_INPUT, EXIT_USAGE = 0, 1, 2
 
@@ -80,12 +89,7 @@ def build_parser() -> argparse.ArgumentParser:
         metavar="W,D|LOTS.geojson",
         help="the lot: width,depth in metres (default 20,20) or GeoJSON footprints",
     )
-    derive.add_argument(
-        "--max-depth", type=int, default=256, metavar="N", help="rule depth limit (256)"
-    )
-    derive.add_argument(
-        "--max-shapes", type=int, default=10_000_000, metavar="N", help="shape budget (10,000,000)"
-    )
+    add_budget_options(derive)
     derive.add_argument(
         "--strict",
         action="store_true",
@@ -142,12 +146,7 @@ def build_parser() -> argparse.ArgumentParser:
     render.add_argument(
         "--lot", metavar="W,D|LOTS.geojson", help="the lot of a .bgr, as for derive"
     )
-    render.add_argument(
-        "--max-depth", type=int, default=256, metavar="N", help="rule depth limit (256)"
-    )
-    render.add_argument(
-        "--max-shapes", type=int, default=10_000_000, metavar="N", help="shape budget (10,000,000)"
-    )
+    add_budget_options(render)
     render.add_argument(
         "--strict", action="store_true", help="treat a .bgr's warnings as errors, as for derive"
     )
@@ -205,6 +204,81 @@ def build_parser() -> argparse.ArgumentParser:
     )
     mode.add_argument("-w", "--write", action="store_true", help="rewrite the files in place")
     return parser
+
+
+def add_budget_options(command: argparse.ArgumentParser) -> None:
+    """The limits a derivation runs under (interpreter/limits.py, docs/limits.md)."""
+    command.add_argument(
+        "--max-depth",
+        type=int,
+        default=DEFAULT_MAX_DEPTH,
+        metavar="N",
+        help=f"rule depth limit (default {DEFAULT_MAX_DEPTH})",
+    )
+    command.add_argument(
+        "--max-shapes",
+        type=int,
+        default=DEFAULT_MAX_SHAPES,
+        metavar="N",
+        help=f"shape budget of the run (default {DEFAULT_MAX_SHAPES:,})",
+    )
+    command.add_argument(
+        "--max-triangles",
+        type=int,
+        default=DEFAULT_MAX_TRIANGLES,
+        metavar="N",
+        help=f"triangle budget of the terminals (default {DEFAULT_MAX_TRIANGLES:,})",
+    )
+    command.add_argument(
+        "--max-memory",
+        metavar="SIZE",
+        help="memory ceiling, e.g. 4G or 512M (default: 80%% of the memory available at start)",
+    )
+
+
+def budgets(args) -> dict | str:
+    """The derive() keywords of the budget options, or what is wrong with them.
+
+    The memory ceiling is enforced twice: the engine measures the process as it derives (a
+    located error), and the process's address space is capped a little above the ceiling, so
+    an allocation that would pass it in one go (a writer's arrays) fails as MemoryError, which
+    main() reports in one line instead of the system killing the process.
+    """
+    if args.max_depth < 1 or args.max_shapes < 1 or args.max_triangles < 1:
+        return "--max-depth, --max-shapes and --max-triangles must be positive"
+    if args.max_memory is None:
+        memory = default_max_memory()
+    else:
+        memory = parse_memory(args.max_memory)
+        if memory is None:
+            return f"--max-memory {args.max_memory}: write a size such as 4G, 512M or 1.5GB"
+    args.memory_ceiling = memory  # for main()'s out-of-memory message
+    if memory is not None:
+        cap_address_space(memory)
+    return {
+        "max_depth": args.max_depth,
+        "max_shapes": args.max_shapes,
+        "max_triangles": args.max_triangles,
+        "max_memory": memory,
+    }
+
+
+def cap_address_space(ceiling: int) -> None:
+    """Lower RLIMIT_AS to what the process has mapped now, plus the ceiling and 1 GB of slack
+    for the mappings that are reserved but never touched (thread stacks, malloc arenas)."""
+    try:
+        import resource
+
+        with open("/proc/self/statm", "rb") as f:
+            mapped = int(f.read().split()[0]) * os.sysconf("SC_PAGE_SIZE")
+    except (ImportError, OSError, ValueError, IndexError):
+        return  # not Linux: the engine's own measurement is the only ceiling
+    wanted = mapped + ceiling + 2**30
+    soft, hard = resource.getrlimit(resource.RLIMIT_AS)
+    if soft == resource.RLIM_INFINITY or wanted < soft:
+        limit = wanted if hard == resource.RLIM_INFINITY else min(wanted, hard)
+        with contextlib.suppress(ValueError, OSError):
+            resource.setrlimit(resource.RLIMIT_AS, (limit, hard))
 
 
 def _read(name: str) -> tuple[str, str]:
@@ -291,7 +365,7 @@ def _parse_value(text: str):
 
 def cmd_derive(args) -> int:
     from .interpreter.derive import derive
-    from .interpreter.writers import write, write_json
+    from .interpreter.writers import write
 
     if args.output in (None, "-") and args.format != "json":
         print(
@@ -307,23 +381,18 @@ def cmd_derive(args) -> int:
             print(f"bgr derive: --set {item}: write NAME=VALUE", file=sys.stderr)
             return EXIT_USAGE
         attrs[name.strip()] = _parse_value(value.strip())
-    if args.max_depth < 1 or args.max_shapes < 1:
-        print("bgr derive: --max-depth and --max-shapes must be positive", file=sys.stderr)
+    limits = budgets(args)
+    if isinstance(limits, str):
+        print(f"bgr derive: {limits}", file=sys.stderr)
         return EXIT_USAGE
     grammar = load(Path(args.file), path=args.file)
     result = derive(
-        grammar,
-        seed=args.seed,
-        attrs=attrs,
-        lot=args.lot,
-        max_depth=args.max_depth,
-        max_shapes=args.max_shapes,
-        strict=args.strict,
+        grammar, seed=args.seed, attrs=attrs, lot=args.lot, strict=args.strict, **limits
     )
     for warning in result.warnings:
         print(warning.render(), file=sys.stderr)
     if args.output in (None, "-"):
-        write_json(result.terminals, sys.stdout, seed=args.seed, attrs=result.attrs)
+        write(result.terminals, Path("-"), seed=args.seed, attrs=result.attrs, fmt="json")
     else:
         write(
             result.terminals, Path(args.output), seed=args.seed, attrs=result.attrs, fmt=args.format
@@ -408,14 +477,15 @@ def cmd_render(args) -> int:
         return usage(
             "--seed, --set, --lot and --strict apply to a .bgr grammar, not to a model file"
         )
-    if args.max_depth < 1 or args.max_shapes < 1:
-        return usage("--max-depth and --max-shapes must be positive")
     attrs = {}
     for item in args.set:
         name, sep, value = item.partition("=")
         if not sep or not name.strip():
             return usage(f"--set {item}: write NAME=VALUE")
         attrs[name.strip()] = _parse_value(value.strip())
+    limits = budgets(args) if is_grammar else {}
+    if isinstance(limits, str):
+        return usage(limits)
     out = Path(args.output)
     if out.suffix.lower() != ".png":  # before deriving: a typo should not cost a derivation
         shown = (
@@ -430,9 +500,8 @@ def cmd_render(args) -> int:
         seed=args.seed or 0,
         attrs=attrs,
         lot=args.lot,
-        max_depth=args.max_depth,
-        max_shapes=args.max_shapes,
         strict=args.strict,
+        **limits,
     )
     for warning in scene.warnings:
         print(warning.render(), file=sys.stderr)
@@ -465,6 +534,11 @@ COMMANDS = {
 }
 
 
+def _ceiling(args) -> str:
+    memory = getattr(args, "memory_ceiling", None)
+    return format_bytes(memory) if memory else "the machine's memory"
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
@@ -479,6 +553,13 @@ def main(argv: list[str] | None = None) -> int:
     except KeyboardInterrupt:
         print("bgr: interrupted", file=sys.stderr)
         return 130
+    except MemoryError:
+        print(
+            f"bgr {args.command}: out of memory (the ceiling is "
+            f"{_ceiling(args)}); derive fewer or smaller shapes, or raise it with --max-memory",
+            file=sys.stderr,
+        )
+        return EXIT_INPUT
     except BrokenPipeError:
         sys.stderr.close()  # the reader went away (bgr fmt x | head): not an error of ours
         return EXIT_OK

@@ -10,7 +10,13 @@ from bgr.grammar.checker import Grammar
 from bgr.grammar.errors import BgrError, Diagnostic, Warnings
 from bgr.grammar.loader import load
 
-from .engine import DEFAULT_MAX_DEPTH, DEFAULT_MAX_SHAPES, Engine
+from .engine import Engine
+from .limits import (
+    DEFAULT_MAX_DEPTH,
+    DEFAULT_MAX_SHAPES,
+    DEFAULT_MAX_TRIANGLES,
+    default_max_memory,
+)
 from .lots import DEFAULT_LOT, Lot, attr_overrides, parse_lot_option, rectangle
 from .randomness import child_hash, name_hash, root_hash
 from .terminals import TerminalTable
@@ -52,6 +58,8 @@ def derive(
     *,
     max_depth: int = DEFAULT_MAX_DEPTH,
     max_shapes: int = DEFAULT_MAX_SHAPES,
+    max_triangles: int = DEFAULT_MAX_TRIANGLES,
+    max_memory: int | None = None,
     start: str | None = None,
     strict: bool = False,
 ) -> Result:
@@ -65,6 +73,11 @@ def derive(
     fit its attr (ignored), a roof built as another kind — is in ``Result.warnings``; with
     ``strict=True`` the first of them is a :class:`bgr.BgrError` instead.  An error raised while
     deriving one of several lots names the lot ("feature 12 (id 4253124): ...").
+
+    The budgets hold for the whole run, all lots together: ``max_depth`` nested rules,
+    ``max_shapes`` shapes, ``max_triangles`` triangles of terminals, and ``max_memory`` bytes
+    held by the process (None: 80 % of the memory the machine has available when the run
+    starts).  Passing one of them raises a located :class:`bgr.BgrError`; see docs/limits.md.
     """
     if not isinstance(grammar, Grammar):
         grammar = load(grammar)
@@ -74,8 +87,11 @@ def derive(
     lots = _lots(lot, warnings)
     attrs = dict(attrs or {})
     values = Engine(grammar, seed, attrs, max_depth, max_shapes).attrs  # the run's attrs
+    if max_memory is None:
+        max_memory = default_max_memory()
     table = TerminalTable()
     shared_cache: dict = {}
+    shapes = triangles = 0  # the budgets are the run's, carried from lot to lot
     several = len(lots) > 1
     for i, each in enumerate(lots):
         lot_name = each.name or (f"lot {i}" if several else "")
@@ -91,10 +107,14 @@ def derive(
                 lot_index=i,
                 warnings=warnings,
                 lot_name=lot_name,
+                max_triangles=max_triangles,
+                max_memory=max_memory,
             )
             engine.table = table
             engine.split_cache = shared_cache
+            engine.shapes, engine.triangles = shapes, triangles
             engine.derive(each.shape.copy(), start, index=i, several=several)
+            shapes, triangles = engine.shapes, engine.triangles
         except BgrError as e:
             raise _naming(e, lot_name) from None
         lot_shape = each.shape  # its frame: the inverse modules read a face's side in it

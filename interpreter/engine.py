@@ -9,6 +9,7 @@ looked up by name in :mod:`bgr.interpreter.operations`, one function each.
 from __future__ import annotations
 
 import gc
+import math
 from dataclasses import replace
 
 from bgr.grammar import nodes as n
@@ -28,6 +29,16 @@ from bgr.grammar.registry import (
 from .expressions import Compiler, Context, RuleRef, evaluate_values, runtime_error
 from .geometry import meshes
 from .geometry.polygons import RECT
+from .limits import (
+    BYTES_PER_SHAPE,
+    DEFAULT_MAX_DEPTH,
+    DEFAULT_MAX_SHAPES,
+    DEFAULT_MAX_TRIANGLES,
+    MAX_COORDINATE,
+    MEMORY_CHECK_EVERY,
+    format_bytes,
+    memory_in_use,
+)
 from .operations import IMPLEMENTATIONS
 from .randomness import Stream, child_hash, name_hash, root_hash
 from .shapes import Flat, Shape, Solid
@@ -45,8 +56,10 @@ def _name_hash(name: str) -> int:
     return found
 
 
-DEFAULT_MAX_DEPTH = 256
-DEFAULT_MAX_SHAPES = 10_000_000
+# operations after which the scope's size or place may have grown past MAX_COORDINATE
+_SCOPE_CHANGERS = frozenset(
+    name for name, op in OPERATIONS.items() if op.family in ("transforms", "roofs", "inserts")
+) | {"extrude", "taper", "footprint"}
 
 
 class Engine:
@@ -62,11 +75,20 @@ class Engine:
         lot_index: int = 0,
         warnings: Warnings | None = None,
         lot_name: str = "",
+        max_triangles: int = DEFAULT_MAX_TRIANGLES,
+        max_memory: int | None = None,
     ) -> None:
         self.grammar, self.seed, self.lot_index = grammar, seed, lot_index
         self.warnings = warnings if warnings is not None else Warnings()
         self.lot_name = lot_name  # put before warnings' messages: "feature 12 (id 4253124): ..."
         self.max_depth, self.max_shapes = max_depth, max_shapes
+        self.max_triangles, self.max_memory = max_triangles, max_memory
+        self.triangles = 0
+        # the shape count at which memory is expected to reach the ceiling (see check_memory)
+        self.memory_full_at: float = math.inf
+        if max_memory is not None:
+            self.memory_full_at = (max_memory - memory_in_use()) / BYTES_PER_SHAPE
+        self._mesh_triangles: list[int] = []  # triangles per library mesh id
         self.compilers: dict[int, Compiler] = {}
         self.attrs = self._prepare_values(grammar, dict(attrs or {}))
         self.table = TerminalTable()
@@ -75,6 +97,7 @@ class Engine:
         self._exprs: dict[int, object] = {}
         self._flat_ids: dict[tuple, int] = {}
         self.split_cache: dict = {}  # (block id, sizes, length) -> placed pieces
+        self.constant_sizes: dict[int, tuple | None] = {}  # id(entries) -> literal sizes
         # id(operation node) -> its signature (the grammar outlives us)
         self.signatures: dict[int, tuple] = {}
         self.uses_center: dict[int, bool] = {}  # id(step list) -> does it call center()?
@@ -100,7 +123,16 @@ class Engine:
             seen.add(id(g))
             for sub in g.imports.values():
                 prepare(sub, {})
-            evaluate_values(g, over, self.compilers, self.seed, self.lot_index)
+            values = evaluate_values(g, over, self.compilers, self.seed, self.lot_index)
+            for name, value in values.items():
+                if isinstance(value, float) and not math.isfinite(value):
+                    item = g.attrs.get(name) or g.consts[name]
+                    raise runtime_error(
+                        g,
+                        item.pos,
+                        f"'{name}' is {value!r}: numbers must be finite",
+                        "a product or power overflowed? Keep values below 1e308",
+                    )
 
         prepare(grammar, overrides)
         values = self.compilers[id(grammar)].values
@@ -186,9 +218,40 @@ class Engine:
                 f"the derivation made more than {self.max_shapes:,} shapes",
                 "a rule multiplies shapes without end? Raise the budget with --max-shapes N",
             )
+        if self.shapes % MEMORY_CHECK_EVERY == 0 and self.max_memory is not None:
+            self.check_memory(module, pos)
+
+    def check_memory(self, module, pos) -> None:
+        """A located error once the process holds more than the memory ceiling."""
+        used = memory_in_use()
+        self.memory_full_at = self.shapes + (self.max_memory - used) / BYTES_PER_SHAPE
+        if used > self.max_memory:
+            raise runtime_error(
+                module,
+                pos,
+                f"the derivation needs more than {format_bytes(self.max_memory)} of memory "
+                f"(after {self.shapes:,} shapes)",
+                "make fewer or larger pieces, derive fewer lots at once, or raise the ceiling "
+                "with --max-memory SIZE",
+            )
+
+    def check_scope(self, module, step, shape: Shape) -> None:
+        """Sizes and places stay finite and below MAX_COORDINATE (an s('1e308) is caught where
+        it is written, not as NaN vertices in a file)."""
+        for v in (*shape.size, *shape.origin):
+            if not -MAX_COORDINATE <= v <= MAX_COORDINATE:  # also false for NaN
+                raise runtime_error(
+                    module,
+                    step.pos,
+                    f"'{step.name}' makes a scope of {v:g} m, beyond the "
+                    f"{MAX_COORDINATE:,.0f} m any shape may reach",
+                    "check the numbers: sizes and positions are metres",
+                )
 
     # ---- terminals -------------------------------------------------------------------------------
-    def emit(self, shape: Shape, label: str, rule: str) -> None:
+    def emit(self, shape: Shape, label: str, rule: str, module, pos: n.Pos) -> None:
+        """Append a terminal row; ``module`` and ``pos`` (where it was made) locate a budget
+        error."""
         t = self.table
         t.label.append(shape.label or label)
         t.rule.append(rule)
@@ -198,7 +261,20 @@ class Engine:
         t.size.append(shape.size)
         t.color.append(shape.color)
         t.material.append(shape.material)
-        t.mesh.append(self.mesh_id(shape.geom))
+        mesh = self.mesh_id(shape.geom)
+        t.mesh.append(mesh)
+        counts = self._mesh_triangles
+        while len(counts) < len(t.library.meshes):
+            counts.append(len(t.library.meshes[len(counts)].faces))
+        self.triangles += counts[mesh]
+        if self.triangles > self.max_triangles:
+            raise runtime_error(
+                module,
+                pos,
+                f"the terminals make more than {self.max_triangles:,} triangles "
+                f"(at '{rule}', terminal {len(t.label):,})",
+                "make fewer or simpler terminals, or raise the budget with --max-triangles N",
+            )
 
     def mesh_id(self, geom) -> int:
         if isinstance(geom, Solid):
@@ -301,7 +377,9 @@ class Application:
         becomes a terminal, in its place among the children (depth first, children in order)."""
         spawned = self.counter
         if not self.steps(shape, steps, self.snapshot(shape, steps)) and self.counter == spawned:
-            self.children.append((EMIT, shape, self.rule.name, self.rule.name))
+            self.children.append(
+                (EMIT, shape, self.rule.name, self.rule.name, self.module, self.rule.pos)
+            )
 
     def steps(self, shape: Shape, steps, received: Shape) -> bool:
         """Run steps; True when the shape was consumed (by a successor, NIL, split, comp...).
@@ -317,6 +395,8 @@ class Application:
             if isinstance(step, n.Operation):
                 if IMPLEMENTATIONS[step.name](self, shape, step, self.arguments(step, received)):
                     consumed = True
+                if step.name in _SCOPE_CHANGERS:
+                    self.engine.check_scope(self.module, step, shape)
             elif isinstance(step, n.Successor):
                 # the last step may hand the shape itself over: nothing uses it afterwards
                 self.successor(shape, step, handover=step is last)
@@ -354,8 +434,22 @@ class Application:
             value if kind == 0 else fn(ctx) if kind == 1 else ("rel", fn(ctx))
             for kind, value, fn in plan
         ]
+        for i, value in enumerate(out):
+            number = value[1] if value.__class__ is tuple else value
+            if number.__class__ is float and not -MAX_COORDINATE <= number <= MAX_COORDINATE:
+                self.out_of_range(step, i, number)
         out.append(received)
         return out
+
+    def out_of_range(self, step: n.Operation, index: int, number: float) -> None:
+        """An operation's number that is not finite, or larger than any building needs."""
+        raise runtime_error(
+            self.module,
+            step.pos,
+            f"'{step.name}' argument {index + 1} is {number:g}: an operation's numbers must be "
+            f"finite and within ±{MAX_COORDINATE:,.0f}",
+            "a product or power overflowed? Sizes and positions are metres",
+        )
 
     def plan(self, step: n.Operation) -> tuple:
         """(kind, constant, compiled) per parameter: 0 a word or default, 1 a value, 2 relative."""
@@ -402,7 +496,7 @@ class Application:
             )
         if member in module.terminals:
             child.label = child.label or member
-            self.children.append((EMIT, child, member, member))
+            self.children.append((EMIT, child, member, member, self.module, step.pos))
             return
         rule = module.rules[member]
         ctx = self.ctx

@@ -45,7 +45,10 @@ class Placed:
 
 
 class SplitError(ValueError):
-    """A size the solver cannot use (not finite); the interpreter reports it at the split."""
+    """A size the solver cannot use (not finite), or more pieces than ``limit`` (``count`` is
+    then how many); the interpreter reports it at the split."""
+
+    count: int | None = None
 
 
 def solve(
@@ -71,10 +74,12 @@ _NO_LIMIT = 1 << 62
 
 
 def _too_many(count: int, limit: int) -> SplitError:
-    return SplitError(
+    error = SplitError(
         f"this split would make {count:,} pieces, more than {limit:,} shapes (what the shape "
         "budget has left)"
     )
+    error.count = count
+    return error
 
 
 def _pieces(items):

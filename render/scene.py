@@ -200,6 +200,8 @@ def load_scene(
     max_depth: int | None = None,
     max_shapes: int | None = None,
     strict: bool = False,
+    max_triangles: int | None = None,
+    max_memory: int | None = None,
 ) -> Scene:
     """A :class:`Scene` from a Scene, a ``bgr.Result``, a terminal table, a trimesh, or a path to
     a ``.bgr`` (derived with ``seed``, ``attrs``, ``lot`` and ``strict``, its warnings kept in
@@ -215,7 +217,12 @@ def load_scene(
 
             limits = {
                 k: v
-                for k, v in (("max_depth", max_depth), ("max_shapes", max_shapes))
+                for k, v in (
+                    ("max_depth", max_depth),
+                    ("max_shapes", max_shapes),
+                    ("max_triangles", max_triangles),
+                    ("max_memory", max_memory),
+                )
                 if v is not None
             }
             grammar = load(path, path=str(source))

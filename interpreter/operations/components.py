@@ -212,6 +212,15 @@ def _matches(app, key, kind: str, index: int, slant: str) -> bool:
 
 def comp(app, shape, step, args) -> bool:
     faces = _faces(app, step, shape)
+    left = app.engine.max_shapes - app.engine.shapes
+    if len(faces) > left:  # counted before any face is made, as a split's pieces are
+        raise runtime_error(
+            app.module,
+            step.pos,
+            f"this comp would make {len(faces):,} faces, more than {left:,} shapes (what the "
+            "shape budget has left)",
+            "simplify the footprint, or raise the budget with --max-shapes",
+        )
     kinds = [_classify(nrm) for _, nrm, _ in faces]
     slants = [_slant(nrm) for _, nrm, _ in faces]
     taken = [False] * len(faces)
@@ -256,6 +265,7 @@ def offset(app, shape, step, args) -> bool:
         piece.origin = shape.world(move)
         piece.size[p], piece.size[q] = w, h
         piece.geom = Flat(geom.k, RECT if is_unit_square(unit) else unit)
+        app.engine.check_scope(app.module, step, piece)  # a negative distance grows the shape
         app.engine.count_shape(app.module, entry.pos)
         app.piece(piece, entry.body)
     return True
@@ -418,8 +428,10 @@ def _sheared_prism(app, shape, flat: Flat, heights: list[float], height: float) 
 def taper(app, shape, step, args) -> bool:
     height, ratio = _height(app, step, args[0]), args[1]
     geom, _ = _into_extrusion_frame(app, step, shape, "face.normal", height)
-    if isinstance(ratio, bool) or not isinstance(ratio, (int, float)) or ratio < 0:
-        raise runtime_error(app.module, step.pos, f"taper() needs a ratio >= 0, got {ratio!r}")
+    if isinstance(ratio, bool) or not isinstance(ratio, (int, float)) or not 0 <= ratio <= 1000:
+        raise runtime_error(
+            app.module, step.pos, f"taper() needs a ratio from 0 to 1000, got {ratio!r}"
+        )
     from ..geometry.meshes import _lift, _orient
     from ..geometry.polygons import triangulate
 

@@ -14,13 +14,38 @@ from bgr.grammar import nodes as n
 from ..expressions import runtime_error
 from ..geometry.meshes import PLANE_AXES
 from ..geometry.polygons import RECT, clip, renormalise
+from ..limits import format_bytes
 from ..shapes import Prism, Solid
 from ..split_solver import Piece, Repeat, SplitError, solve
+
+
+def _constant(entries) -> tuple | None:
+    """The sizes when every one is a number written in the grammar (most façade splits), so
+    they need no evaluating per shape; None when one is an expression."""
+    out = []
+    for entry in entries:
+        if isinstance(entry, n.Group):
+            inner = _constant(entry.entries)
+            if inner is None:
+                return None
+            out.append(inner)
+        elif isinstance(entry.key, n.Number) and math.isfinite(entry.key.value):
+            out.append(float(entry.key.value))
+        else:
+            return None
+    return tuple(out)
 
 
 def _sizes(app, entries) -> tuple:
     """The evaluated sizes of a block's entries (a nested tuple for repeat groups): with the
     block and the length, all the placement depends on, so it keys the solver's memo."""
+    known = app.engine.constant_sizes  # id(entries) -> sizes; the grammar outlives the engine
+    key = id(entries)
+    if key not in known:
+        known[key] = _constant(entries)
+    found = known[key]
+    if found is not None:
+        return found
     out = []
     for entry in entries:
         if isinstance(entry, n.Group):
@@ -79,9 +104,20 @@ def split(app, shape, step, args) -> bool:
         if step.block.repeat:
             items = (Repeat(items),)
         engine = app.engine
+        by_budget = engine.max_shapes - engine.shapes
+        room = engine.memory_full_at - engine.shapes  # inf without a ceiling
+        by_memory = max(int(room), 0) if room < by_budget else by_budget
         try:
-            placed = solve(items, length, limit=engine.max_shapes - engine.shapes)
+            placed = solve(items, length, limit=min(by_budget, by_memory))
         except SplitError as e:
+            if e.count is not None and by_memory < by_budget:
+                raise runtime_error(
+                    app.module,
+                    step.pos,
+                    f"this split would make {e.count:,} pieces, more than the memory ceiling "
+                    f"({format_bytes(engine.max_memory or 0)}) leaves room for",
+                    "make the pieces larger, or raise the ceiling with --max-memory SIZE",
+                ) from None
             raise runtime_error(
                 app.module,
                 step.pos,
@@ -92,11 +128,13 @@ def split(app, shape, step, args) -> bool:
             cache.clear()
         cache[key] = placed
     pieces = []
+    engine = app.engine
     for p in placed:
         lo, hi = (p.offset / length, (p.offset + p.size) / length) if length > 0 else (0.0, 0.0)
         geom = _clip(app, step, shape.geom, axis, lo, hi)
         if geom is None:
             continue
+        engine.count_shape(app.module, p.payload.pos)  # as it is made: memory is watched
         piece = shape.copy().cut_from(shape)
         move = [0.0, 0.0, 0.0]
         move[axis] = p.offset
@@ -106,6 +144,5 @@ def split(app, shape, step, args) -> bool:
         pieces.append((piece, p.payload))
     total = len(pieces)
     for index, (piece, entry) in enumerate(pieces):
-        app.engine.count_shape(app.module, entry.pos)
         app.piece(piece, entry.body, split=(index, total))
     return True

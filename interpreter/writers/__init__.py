@@ -10,11 +10,15 @@ file behind.  Failures a user can act on (unknown format, unwritable folder) are
 
 from __future__ import annotations
 
+import math
 import sys
 from collections.abc import Callable
 from pathlib import Path
 
+import numpy as np
+
 from ...grammar.errors import BgrError, Diagnostic
+from ..limits import MAX_COORDINATE
 from ..terminals import TerminalTable
 from .atomic import atomic_files
 from .glb import write_glb, write_gltf
@@ -45,9 +49,36 @@ __all__ = [
     "read_glb",
     "bake",
     "format_of",
+    "check_writable",
     "FORMATS",
     "EXTENSIONS",
 ]
+
+
+def check_writable(table: TerminalTable, attrs: dict) -> None:
+    """Refuse a table no file can hold: a terminal placed at a non-finite or absurd coordinate
+    (JSON has no NaN, a GLB reader would drop the scene), or a non-finite attr value.  The
+    engine stops such shapes where they are made; this guards tables built another way."""
+    table.freeze()
+    for name, value in attrs.items():
+        if isinstance(value, float) and not math.isfinite(value):
+            raise BgrError(f"cannot write attr '{name}' = {value!r}: numbers must be finite")
+    if not len(table):
+        return
+    for mesh in table.library.meshes:
+        if not np.isfinite(mesh.vertices).all():
+            raise BgrError(f"cannot write the mesh '{mesh.name}': its vertices are not finite")
+    columns = (table.origin, table.size, table.axes.reshape(len(table), 9))
+    bad = np.zeros(len(table), dtype=bool)
+    for column in columns:
+        bad |= ~(np.abs(column) <= MAX_COORDINATE).all(axis=1)  # NaN compares false
+    if bad.any():
+        row = int(np.flatnonzero(bad)[0])
+        raise BgrError(
+            f"cannot write terminal {row} ('{table.label[row]}', made by rule "
+            f"'{table.rule[row]}' at {table.path[row]}): its scope is not finite or lies "
+            f"beyond {MAX_COORDINATE:,.0f} m ({int(bad.sum()):,} terminals like it)"
+        )
 
 
 def _known() -> str:
@@ -84,7 +115,7 @@ def write(
     ``path`` ``"-"`` writes to standard output and needs ``fmt`` (not ``obj``, which is two files).
     For ``.obj`` the ``.mtl`` is written beside it, with the same stem.
     """
-    table.freeze()
+    check_writable(table, attrs)
     path = Path(path)
     if str(path) == "-":
         if fmt is None:
