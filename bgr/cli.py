@@ -277,8 +277,26 @@ def cap_address_space(ceiling: int) -> None:
     soft, hard = resource.getrlimit(resource.RLIMIT_AS)
     if soft == resource.RLIM_INFINITY or wanted < soft:
         limit = wanted if hard == resource.RLIM_INFINITY else min(wanted, hard)
-        with contextlib.suppress(ValueError, OSError):
+        with contextlib.suppress(ValueError, OSError, OverflowError):
             resource.setrlimit(resource.RLIMIT_AS, (limit, hard))
+
+
+@contextlib.contextmanager
+def _address_space_restored():
+    """Put back the address-space limit cap_address_space() lowered: main() may be called in a
+    process that goes on (a test, a server), whose later work must not inherit the ceiling."""
+    try:
+        import resource
+
+        before = resource.getrlimit(resource.RLIMIT_AS)
+    except ImportError:
+        yield
+        return
+    try:
+        yield
+    finally:
+        with contextlib.suppress(ValueError, OSError):
+            resource.setrlimit(resource.RLIMIT_AS, before)
 
 
 def _read(name: str) -> tuple[str, str]:
@@ -546,7 +564,8 @@ def main(argv: list[str] | None = None) -> int:
         parser.print_help(sys.stderr)
         return EXIT_USAGE
     try:
-        return COMMANDS[args.command](args)
+        with _address_space_restored():
+            return COMMANDS[args.command](args)
     except BgrError as e:
         print(e.render(), file=sys.stderr)
         return EXIT_INPUT
