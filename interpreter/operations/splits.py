@@ -15,7 +15,7 @@ from ..expressions import runtime_error
 from ..geometry.meshes import PLANE_AXES
 from ..geometry.polygons import RECT, clip, renormalise
 from ..limits import format_bytes
-from ..shapes import Prism, Solid
+from ..shapes import Flat, Prism, Solid
 from ..split_solver import Piece, Repeat, SplitError, solve
 
 
@@ -129,16 +129,28 @@ def split(app, shape, step, args) -> bool:
         cache[key] = placed
     pieces = []
     engine = app.engine
+    whole = shape.geom
+    # the pieces share the whole's geometry when cutting leaves it as it is (see _clip)
+    uncut = (
+        (isinstance(whole, Solid) and whole.name == "cube")
+        or (isinstance(whole, Prism) and (axis == whole.k or whole.polys == RECT))
+        or (isinstance(whole, Flat) and axis != whole.k and whole.polys == RECT)
+    )
+    frame = (tuple(shape.origin), shape.axes)
+    (ox, oy, oz), (dx, dy, dz) = shape.origin, shape.axes[axis]
     for p in placed:
-        lo, hi = (p.offset / length, (p.offset + p.size) / length) if length > 0 else (0.0, 0.0)
-        geom = _clip(app, step, shape.geom, axis, lo, hi)
-        if geom is None:
-            continue
+        if uncut:
+            geom = whole
+        else:
+            lo, hi = (p.offset / length, (p.offset + p.size) / length) if length > 0 else (0, 0)
+            geom = _clip(app, step, whole, axis, lo, hi)
+            if geom is None:
+                continue
         engine.count_shape(app.module, p.payload.pos)  # as it is made: memory is watched
-        piece = shape.copy().cut_from(shape)
-        move = [0.0, 0.0, 0.0]
-        move[axis] = p.offset
-        piece.origin = shape.world(move)
+        piece = shape.copy()
+        piece.frame = frame
+        at = p.offset
+        piece.origin = [ox + at * dx, oy + at * dy, oz + at * dz]
         piece.size[axis] = p.size
         piece.geom = geom
         pieces.append((piece, p.payload))
