@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import os
+from collections.abc import Iterable
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 
@@ -54,6 +55,7 @@ def derive(
     max_shapes: int = DEFAULT_MAX_SHAPES,
     start: str | None = None,
     strict: bool = False,
+    allow_paths: Iterable[str | os.PathLike] = (),
 ) -> Result:
     """Derive a grammar on one lot or several.
 
@@ -65,9 +67,10 @@ def derive(
     fit its attr (ignored), a roof built as another kind — is in ``Result.warnings``; with
     ``strict=True`` the first of them is a :class:`bgr.BgrError` instead.  An error raised while
     deriving one of several lots names the lot ("feature 12 (id 4253124): ...").
+    ``allow_paths`` is passed to :func:`bgr.load` when ``grammar`` is not loaded yet.
     """
     if not isinstance(grammar, Grammar):
-        grammar = load(grammar)
+        grammar = load(grammar, allow_paths=allow_paths)
     if isinstance(seed, bool) or not isinstance(seed, int):
         raise BgrError(f"the seed must be a whole number, got {seed!r}")
     warnings = Warnings(strict)
