@@ -15,7 +15,7 @@ from . import nodes as n
 from .checker import Checker, Grammar
 from .errors import BgrCheckError, BgrError, BgrSyntaxError, Diagnostic, source_line, suggest
 from .parser import parse
-from .paths import ALLOW_HINT, read_input, roots_of, within
+from .paths import ALLOW_HINT, check_input, read_input, roots_of, within
 
 STDLIB_DIR = Path(__file__).resolve().parent.parent / "stdlib"
 
@@ -159,6 +159,11 @@ class Loader:
                     f"cannot import '{item.path}': only .bgr files can be imported",
                     "its text is not read; import a .bgr grammar",
                 )
+                return None
+            try:
+                check_input(target, "imported file")
+            except BgrError as e:  # a FIFO, a device: say so at the import line
+                fail(f"cannot import '{item.path}': {e.message}", e.hint)
                 return None
             if not target.is_file():
                 fail(f"cannot find the imported file '{item.path}'", f"looked for {target}")
