@@ -10,7 +10,6 @@ import time
 import pytest
 
 import bgr
-from bgr.cli import main
 from bgr.interpreter.writers.atomic import is_stale, write_text
 
 SECRET = "TOP-SECRET-4242"
