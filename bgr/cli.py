@@ -41,8 +41,10 @@ def build_parser() -> argparse.ArgumentParser:
         prog="bgr",
         description="bgr: a building-grammar toolkit. "
         "Write .bgr shape grammars, check and format them, derive them into meshes.",
-        epilog="Exit status: 0 success, 1 bad input, 2 bad usage. "
-        "Language reference: docs/language.md.",
+        epilog="Exit status: 0 success, 1 bad input, 2 bad usage, 130 interrupted, 143 terminated "
+        "(SIGTERM). Imports and assets stay in the grammar's folder and the stdlib unless "
+        "--allow-path widens them; inputs and outputs must be regular files. "
+        "Language reference: docs/language.md; files: docs/cli.md.",
     )
     parser.add_argument("--version", action="version", version=f"bgr {__version__}")
     commands = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
