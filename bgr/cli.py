@@ -11,8 +11,8 @@ from __future__ import annotations
 import argparse
 import contextlib
 import os
+import signal
 import sys
-import tempfile
 import traceback
 from pathlib import Path
 
@@ -31,6 +31,12 @@ from .interpreter.limits import (
 )
 
 EXIT_OK, EXIT_INPUT, EXIT_USAGE = 0, 1, 2
+EXIT_INTERRUPTED, EXIT_TERMINATED = 130, 143  # 128 + SIGINT, 128 + SIGTERM, as shells report
+
+ALLOW_PATH_HELP = (
+    "also let imports and assets read files under DIR (repeatable); by default they must stay "
+    "in the grammar's own folder or the stdlib"
+)
 
 
 class _Parser(argparse.ArgumentParser):
@@ -44,8 +50,10 @@ def build_parser() -> argparse.ArgumentParser:
         prog="bgr",
         description="bgr: a building-grammar toolkit. "
         "Write .bgr shape grammars, check and format them, derive them into meshes.",
-        epilog="Exit status: 0 success, 1 bad input, 2 bad usage. "
-        "Language reference: docs/language.md.",
+        epilog="Exit status: 0 success, 1 bad input, 2 bad usage, 130 interrupted, 143 terminated "
+        "(SIGTERM). Imports and assets stay in the grammar's folder and the stdlib unless "
+        "--allow-path widens them; inputs and outputs must be regular files. "
+        "Language reference: docs/language.md; files: docs/cli.md.",
     )
     parser.add_argument("--version", action="version", version=f"bgr {__version__}")
     commands = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
@@ -60,6 +68,13 @@ def build_parser() -> argparse.ArgumentParser:
         "files", nargs="+", metavar="FILE", help=".bgr files ('-' reads standard input)"
     )
     check.add_argument("-q", "--quiet", action="store_true", help="print nothing for clean files")
+    check.add_argument(
+        "--allow-path",
+        action="append",
+        default=[],
+        metavar="DIR",
+        help=ALLOW_PATH_HELP,
+    )
 
     derive = commands.add_parser(
         "derive",
@@ -95,6 +110,13 @@ def build_parser() -> argparse.ArgumentParser:
         action="store_true",
         help="treat warnings as errors: a footprint that cannot be used, a property that does "
         "not fit its attr, a roof built as another kind",
+    )
+    derive.add_argument(
+        "--allow-path",
+        action="append",
+        default=[],
+        metavar="DIR",
+        help=ALLOW_PATH_HELP,
     )
 
     render = commands.add_parser(
@@ -150,6 +172,13 @@ def build_parser() -> argparse.ArgumentParser:
     render.add_argument(
         "--strict", action="store_true", help="treat a .bgr's warnings as errors, as for derive"
     )
+    render.add_argument(
+        "--allow-path",
+        action="append",
+        default=[],
+        metavar="DIR",
+        help=ALLOW_PATH_HELP,
+    )
 
     infer = commands.add_parser(
         "infer",
@@ -188,6 +217,13 @@ def build_parser() -> argparse.ArgumentParser:
         "--seed", type=int, default=0, help="seed for deriving a .bgr input (default 0)"
     )
     infer.add_argument("--lot", metavar="W,D|LOTS.geojson", help="lot for deriving a .bgr input")
+    infer.add_argument(
+        "--allow-path",
+        action="append",
+        default=[],
+        metavar="DIR",
+        help=ALLOW_PATH_HELP,
+    )
 
     fmt = commands.add_parser(
         "fmt",
@@ -311,9 +347,9 @@ def cmd_check(args) -> int:
         try:
             if name == "-":
                 text, _ = _read(name)
-                load(text, path="<stdin>")
+                load(text, path="<stdin>", allow_paths=args.allow_path)
             else:
-                load(Path(name), path=name)
+                load(Path(name), path=name, allow_paths=args.allow_path)
         except BgrError as e:
             print(e.render(), file=sys.stderr)
             status = EXIT_INPUT
@@ -354,18 +390,9 @@ def cmd_fmt(args) -> int:
 
 def write_atomic(path: Path, text: str) -> None:
     """Write beside the target and rename over it, so a failure never leaves half a file."""
-    folder = path.resolve().parent
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=folder)
-    try:
-        with os.fdopen(fd, "w", encoding="utf-8", newline="") as f:
-            f.write(text)
-        if path.exists():
-            os.chmod(tmp, path.stat().st_mode & 0o7777)
-        os.replace(tmp, path)
-    except BaseException:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
-        raise
+    from .interpreter.writers.atomic import write_text
+
+    write_text(path, text)
 
 
 def _parse_value(text: str):
@@ -403,7 +430,7 @@ def cmd_derive(args) -> int:
     if isinstance(limits, str):
         print(f"bgr derive: {limits}", file=sys.stderr)
         return EXIT_USAGE
-    grammar = load(Path(args.file), path=args.file)
+    grammar = load(Path(args.file), path=args.file, allow_paths=args.allow_path)
     result = derive(
         grammar, seed=args.seed, attrs=attrs, lot=args.lot, strict=args.strict, **limits
     )
@@ -441,7 +468,9 @@ def cmd_infer(args) -> int:
             fixed[label] = value
     from .inverse.schema import infer
 
-    text = format_module(infer(args.input, fixed=fixed, seed=args.seed, lot=args.lot))
+    text = format_module(
+        infer(args.input, fixed=fixed, seed=args.seed, lot=args.lot, allow_paths=args.allow_path)
+    )
     if args.output in (None, "-"):
         sys.stdout.write(text)
     else:
@@ -520,6 +549,7 @@ def cmd_render(args) -> int:
         lot=args.lot,
         strict=args.strict,
         **limits,
+        allow_paths=args.allow_path,
     )
     for warning in scene.warnings:
         print(warning.render(), file=sys.stderr)
@@ -563,15 +593,19 @@ def main(argv: list[str] | None = None) -> int:
     if args.command is None:
         parser.print_help(sys.stderr)
         return EXIT_USAGE
+    previous = _on_sigterm(_terminate)
     try:
         with _address_space_restored():
             return COMMANDS[args.command](args)
     except BgrError as e:
         print(e.render(), file=sys.stderr)
         return EXIT_INPUT
+    except Terminated:
+        print("bgr: terminated", file=sys.stderr)
+        return EXIT_TERMINATED
     except KeyboardInterrupt:
         print("bgr: interrupted", file=sys.stderr)
-        return 130
+        return EXIT_INTERRUPTED
     except MemoryError:
         print(
             f"bgr {args.command}: out of memory (the ceiling is "
@@ -591,6 +625,27 @@ def main(argv: list[str] | None = None) -> int:
             file=sys.stderr,
         )
         return EXIT_INPUT
+    finally:
+        if previous is not None:
+            _on_sigterm(previous)
+
+
+class Terminated(KeyboardInterrupt):
+    """SIGTERM, raised where the program is, so that it unwinds as for Ctrl-C: the atomic
+    writers remove their temporaries (a ``kill`` leaves no ``.tmp`` beside the output)."""
+
+
+def _terminate(signum, frame) -> None:
+    raise Terminated
+
+
+def _on_sigterm(handler):
+    """Install ``handler`` for SIGTERM and return the previous one; None where signals cannot
+    be set (not the main thread, or no SIGTERM)."""
+    try:
+        return signal.signal(signal.SIGTERM, handler)
+    except (ValueError, AttributeError, OSError):
+        return None
 
 
 if __name__ == "__main__":

@@ -10,6 +10,7 @@ from __future__ import annotations
 import re
 from collections.abc import Set as AbstractSet
 from dataclasses import dataclass, field
+from pathlib import Path
 
 from . import nodes as n
 from .errors import Diagnostic, source_line, suggest
@@ -72,6 +73,9 @@ class Grammar:
     imports: dict[str, Grammar] = field(default_factory=dict)
     start: str | None = None
     version: int = 1
+    # the folders its imports and assets may resolve in (grammar/paths.py), set by bgr.load;
+    # empty (a Grammar made by hand) leaves its assets unchecked
+    roots: tuple[Path, ...] = ()
 
     def lookup_module(self, dotted: str) -> tuple[Grammar, str]:
         """Split ``alias.Name`` into (module, member); a plain name is this module's own."""

@@ -129,11 +129,12 @@ def read_json(path, what: str, hint: str | None = None):
     """The parsed JSON of a file, or a BgrError that says which file and what is wrong with it
     (``what`` names the file's role: "lot file", "camera file"...)."""
     import json
-    from pathlib import Path
+
+    from .paths import read_input  # refuses FIFOs, devices and /proc before opening
 
     shown = str(path)
     try:
-        return json.loads(Path(path).read_text(encoding="utf-8"))
+        return json.loads(read_input(path, what).decode("utf-8"))
     except FileNotFoundError:
         raise BgrError(Diagnostic(shown, 0, 0, f"no such {what}", hint)) from None
     except (OSError, UnicodeDecodeError) as exc:

@@ -8,12 +8,14 @@ file involved is collected and raised together as one :class:`BgrError`.
 from __future__ import annotations
 
 import os
+from collections.abc import Iterable
 from pathlib import Path
 
 from . import nodes as n
 from .checker import Checker, Grammar
 from .errors import BgrCheckError, BgrError, BgrSyntaxError, Diagnostic, source_line, suggest
 from .parser import parse
+from .paths import ALLOW_HINT, check_input, read_input, roots_of, within
 
 STDLIB_DIR = Path(__file__).resolve().parent.parent / "stdlib"
 
@@ -33,10 +35,25 @@ def stdlib_modules() -> list[str]:
 
 
 def read_source(path: str | os.PathLike) -> str:
-    """Read a .bgr file as UTF-8, with errors a user can act on."""
+    """Read a .bgr file as UTF-8, with errors a user can act on.
+
+    Only ``.bgr`` files are read: error messages quote the source, so reading any other file as
+    a grammar could print its lines (a password file, a process environment).  Special files
+    (FIFOs, devices, /proc) are refused before they are opened (:mod:`.paths`).
+    """
     shown = str(path)
+    if Path(path).suffix.lower() != ".bgr":
+        raise BgrError(
+            Diagnostic(
+                shown,
+                0,
+                0,
+                "not a .bgr file: grammars are read from .bgr files only",
+                "rename it to end in .bgr (its text is not shown here)",
+            )
+        )
     try:
-        data = Path(path).read_bytes()
+        data = read_input(path, "grammar")
     except FileNotFoundError:
         raise BgrError(Diagnostic(shown, 0, 0, "no such file", "check the path")) from None
     except IsADirectoryError:
@@ -69,7 +86,8 @@ def decode(data: bytes, path: str) -> str:
 class Loader:
     """Loads a root file and everything it imports, each file once."""
 
-    def __init__(self) -> None:
+    def __init__(self, roots: tuple[Path, ...] = ()) -> None:
+        self.roots = roots  # the folders imports may resolve in (paths.roots_of)
         self.done: dict[str, Grammar] = {}
         self.failed: set[str] = set()
         self.diagnostics: list[Diagnostic] = []
@@ -82,7 +100,7 @@ class Loader:
         except BgrError as e:
             self.diagnostics += e.diagnostics
             return None
-        grammar = Grammar(path, module)
+        grammar = Grammar(path, module, roots=self.roots)
         folder = Path(key).parent if key else Path.cwd()
         broken: dict[str, bool] = {}
         for item in module.items:
@@ -129,6 +147,24 @@ class Loader:
         else:
             target = folder / (item.path or "")  # the parser sets path when module is None
             shown = _display(target)
+            if not within(target, self.roots):
+                fail(
+                    f"cannot import '{item.path}': it is outside the folders this grammar may "
+                    "read (" + ", ".join(_display(r) for r in self.roots) + ")",
+                    ALLOW_HINT,
+                )
+                return None
+            if target.suffix.lower() != ".bgr":
+                fail(
+                    f"cannot import '{item.path}': only .bgr files can be imported",
+                    "its text is not read; import a .bgr grammar",
+                )
+                return None
+            try:
+                check_input(target, "imported file")
+            except BgrError as e:  # a FIFO, a device: say so at the import line
+                fail(f"cannot import '{item.path}': {e.message}", e.hint)
+                return None
             if not target.is_file():
                 fail(f"cannot find the imported file '{item.path}'", f"looked for {target}")
                 return None
@@ -161,12 +197,21 @@ class Loader:
         return grammar
 
 
-def load(source: str | bytes | os.PathLike, path: str | None = None) -> Grammar:
+def load(
+    source: str | bytes | os.PathLike,
+    path: str | None = None,
+    *,
+    allow_paths: Iterable[str | os.PathLike] = (),
+) -> Grammar:
     """Parse, resolve and check a grammar; return it, or raise :class:`BgrError` with every problem.
 
     ``source`` is a path (a :class:`os.PathLike`, or a one-line string naming an existing file or
     ending in ``.bgr``), or the text of a grammar (a string with a newline or ``-->`` in it, or
     bytes).  ``path`` names text in messages and is the base for its relative imports.
+
+    Imports and assets must resolve (symlinks followed) inside the grammar's folder, the bundled
+    stdlib, or a folder of ``allow_paths``; the grammar's folder is that of the file, or of
+    ``path`` when it ends in ``.bgr``, else the current working folder (text given as such).
     """
     key = None
     if isinstance(source, bytes):
@@ -183,7 +228,7 @@ def load(source: str | bytes | os.PathLike, path: str | None = None) -> Grammar:
         )
     if path is not None and key is None and Path(path).suffix == ".bgr":
         key = str(Path(path).resolve())
-    loader = Loader()
+    loader = Loader(roots_of(Path(key).parent if key else Path.cwd(), allow_paths))
     try:
         grammar = loader.load_text(text, path or "<text>", key, (key,) if key else ())
     except RecursionError:

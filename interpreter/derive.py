@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import os
+from collections.abc import Iterable
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 
@@ -62,6 +63,7 @@ def derive(
     max_memory: int | None = None,
     start: str | None = None,
     strict: bool = False,
+    allow_paths: Iterable[str | os.PathLike] = (),
 ) -> Result:
     """Derive a grammar on one lot or several.
 
@@ -78,9 +80,11 @@ def derive(
     ``max_shapes`` shapes, ``max_triangles`` triangles of terminals, and ``max_memory`` bytes
     held by the process (None: 80 % of the memory the machine has available when the run
     starts).  Passing one of them raises a located :class:`bgr.BgrError`; see docs/limits.md.
+
+    ``allow_paths`` is passed to :func:`bgr.load` when ``grammar`` is not loaded yet.
     """
     if not isinstance(grammar, Grammar):
-        grammar = load(grammar)
+        grammar = load(grammar, allow_paths=allow_paths)
     if isinstance(seed, bool) or not isinstance(seed, int):
         raise BgrError(f"the seed must be a whole number, got {seed!r}")
     warnings = Warnings(strict)

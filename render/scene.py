@@ -19,6 +19,7 @@ triangles came from.
 from __future__ import annotations
 
 import os
+from collections.abc import Iterable
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -162,11 +163,12 @@ def _glb_materials(gltf: dict) -> tuple[list[str], np.ndarray]:
 
 def from_gltf(path: str | os.PathLike) -> Scene:
     """A .glb or .gltf file, instances expanded (``read_glb``); parts and labels by material."""
+    from ..grammar.paths import read_input
     from ..interpreter.writers.glb_read import parse, read_glb
 
     shown = str(path)
     try:
-        data = Path(path).read_bytes()
+        data = read_input(path, "model file")
         gltf, _ = parse(data)
         mesh = read_glb(path)
         names, material = _glb_materials(gltf)
@@ -202,10 +204,12 @@ def load_scene(
     strict: bool = False,
     max_triangles: int | None = None,
     max_memory: int | None = None,
+    allow_paths: Iterable[str | os.PathLike] = (),
 ) -> Scene:
     """A :class:`Scene` from a Scene, a ``bgr.Result``, a terminal table, a trimesh, or a path to
-    a ``.bgr`` (derived with ``seed``, ``attrs``, ``lot`` and ``strict``, its warnings kept in
-    ``Scene.warnings``), ``.glb`` or ``.gltf`` file."""
+    a ``.bgr`` (loaded with ``allow_paths`` as :func:`bgr.load`, derived with ``seed``,
+    ``attrs``, ``lot`` and ``strict``, its warnings kept in ``Scene.warnings``), ``.glb`` or
+    ``.gltf`` file."""
     if isinstance(source, Scene):
         return source
     if isinstance(source, (str, os.PathLike)):
@@ -225,7 +229,7 @@ def load_scene(
                 )
                 if v is not None
             }
-            grammar = load(path, path=str(source))
+            grammar = load(path, path=str(source), allow_paths=allow_paths)
             result = derive(grammar, seed=seed, attrs=attrs, lot=lot, strict=strict, **limits)
             return from_result(result)
         if suffix in (".glb", ".gltf"):

@@ -25,6 +25,12 @@ def test_version_and_help():
     assert out.returncode == 0 and "check" in out.stdout and "fmt" in out.stdout
 
 
+def test_allow_path_is_an_option_of_every_command_that_loads_a_grammar():
+    for command in ("check", "derive", "render", "infer"):
+        out = run(command, "--help")
+        assert out.returncode == 0 and "--allow-path DIR" in out.stdout, command
+
+
 def test_no_command_is_bad_usage():
     assert run().returncode == 2
 

@@ -6,6 +6,8 @@ from pathlib import Path
 
 import numpy as np
 
+from bgr.grammar.errors import BgrError
+from bgr.grammar.paths import ALLOW_HINT, check_input, within
 from bgr.grammar.registry import PRIMITIVES
 
 from ..expressions import runtime_error
@@ -57,6 +59,17 @@ def _load_asset(app, step, module, asset):
     path = (base / asset.path).resolve()
     if path in cache:
         return cache[path]
+    if module.roots and not within(path, module.roots):
+        raise runtime_error(
+            module,
+            asset.pos,
+            f"asset file '{asset.path}' is outside the folders this grammar may read",
+            ALLOW_HINT,
+        )
+    try:
+        check_input(path, "asset file")
+    except BgrError as e:  # located at the asset line, as the other asset errors are
+        raise runtime_error(module, asset.pos, e.message, e.hint) from None
     if not path.is_file():
         raise runtime_error(
             module, asset.pos, f"asset file '{asset.path}' not found", f"looked for {path}"

@@ -17,6 +17,7 @@ import numpy as np
 import trimesh
 
 from ...grammar.errors import BgrError
+from ...grammar.paths import read_input
 
 _DTYPES = {5120: "i1", 5121: "u1", 5122: "<i2", 5123: "<u2", 5125: "<u4", 5126: "<f4"}
 _WIDTH = {"SCALAR": 1, "VEC2": 2, "VEC3": 3, "VEC4": 4, "MAT4": 16}
@@ -101,7 +102,7 @@ def _to_srgb(linear) -> np.ndarray:
 
 def read_glb(path: Path | str) -> trimesh.Trimesh:
     """World-space triangles of every node of the default scene, with per-face colours."""
-    gltf, blob = parse(Path(path).read_bytes())
+    gltf, blob = parse(read_input(path, "model file"))
     nodes, meshes, materials = (
         gltf.get("nodes", []),
         gltf.get("meshes", []),

@@ -14,19 +14,29 @@ from __future__ import annotations
 
 import json
 import os
+from collections.abc import Iterable
 from pathlib import Path
 
 from bgr.grammar import nodes as n
 from bgr.grammar.errors import BgrError, Diagnostic
+from bgr.grammar.paths import read_input
 
 from .model import Model
 
 __all__ = ["Model", "check_derives", "infer", "read_model", "source_lot"]
 
 
-def read_model(source, *, fixed: dict[str, bool] | None = None, seed: int = 0, lot=None) -> Model:
+def read_model(
+    source,
+    *,
+    fixed: dict[str, bool] | None = None,
+    seed: int = 0,
+    lot=None,
+    allow_paths: Iterable[str | os.PathLike] = (),
+) -> Model:
     """The Model of ``source``: a terminal-list or captured-model JSON path (or its parsed
-    dict), a .bgr path (derived with ``seed`` and ``lot`` first), or a ``bgr.Result``."""
+    dict), a .bgr path (derived with ``seed`` and ``lot`` first, loaded with ``allow_paths`` as
+    :func:`bgr.load`), or a ``bgr.Result``."""
     from .terminals import model_from_terminals
 
     if hasattr(source, "terminals") and hasattr(source, "attrs"):  # a bgr.Result
@@ -42,13 +52,15 @@ def read_model(source, *, fixed: dict[str, bool] | None = None, seed: int = 0, l
     path = Path(os.fspath(source))
     shown = str(source)
     if path.suffix.lower() == ".bgr":
+        from bgr.grammar.loader import load
         from bgr.interpreter.derive import derive
 
-        model = read_model(derive(path, seed=seed, lot=lot), fixed=fixed)
+        grammar = load(path, allow_paths=allow_paths)
+        model = read_model(derive(grammar, seed=seed, lot=lot), fixed=fixed)
         model.source = shown
         return model
     try:
-        text = path.read_text(encoding="utf-8")
+        text = read_input(path, "input file").decode("utf-8")
     except FileNotFoundError:
         raise BgrError(
             Diagnostic(
@@ -87,14 +99,21 @@ def _from_dict(data, shown: str, fixed) -> Model:
     )
 
 
-def infer(source, *, fixed: dict[str, bool] | None = None, seed: int = 0, lot=None) -> n.Module:
+def infer(
+    source,
+    *,
+    fixed: dict[str, bool] | None = None,
+    seed: int = 0,
+    lot=None,
+    allow_paths: Iterable[str | os.PathLike] = (),
+) -> n.Module:
     """The style grammar of ``source`` (see :func:`read_model`) as a syntax tree.
 
     The grammar is derived once on the source's own size before it is returned (see
     :func:`check_derives`): a grammar that cannot derive is never handed out to be written."""
     from .emit import Emitter
 
-    model = read_model(source, fixed=fixed, seed=seed, lot=lot)
+    model = read_model(source, fixed=fixed, seed=seed, lot=lot, allow_paths=allow_paths)
     module = Emitter(model).module()
     check_derives(module, model)
     return module

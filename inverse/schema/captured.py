@@ -29,6 +29,7 @@ import sys
 from pathlib import Path
 
 from bgr.grammar.errors import BgrError, Diagnostic, suggest
+from bgr.grammar.paths import read_input
 
 from .model import Block, Cell, Face, Model, default_fixed
 from .terminals import _set_fixed, link_faces
@@ -1109,7 +1110,7 @@ def load_captured(path: str | Path, fixed: dict[str, bool] | None = None) -> Mod
     """Read and check a captured-model JSON file: see :func:`model_from_captured`."""
     shown = str(path)
     try:
-        text = Path(path).read_text(encoding="utf-8")
+        text = read_input(path, "captured model").decode("utf-8")
     except FileNotFoundError:
         raise _error(shown, "", "no such file") from None
     except IsADirectoryError:
