@@ -164,8 +164,12 @@ def test_recursive_func_is_bounded_while_deriving():
 
 def _nested_blocks(inner: str, levels: int = MAX_BLOCK_NESTING) -> str:
     half = levels // 2
-    return "[ " * half + "split(x) { 1: " * (levels - half) + inner + " }" * (levels - half) + (
-        " ]" * half
+    return (
+        "[ " * half
+        + "split(x) { 1: " * (levels - half)
+        + inner
+        + " }" * (levels - half)
+        + (" ]" * half)
     )
 
 
