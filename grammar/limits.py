@@ -13,7 +13,6 @@ Flat chains are not nesting: every stage handles the left spine of an operator c
 from __future__ import annotations
 
 from collections.abc import Callable, Iterator
-from typing import Any, cast
 
 from . import nodes as n
 
@@ -23,6 +22,9 @@ branches), the bodies of the funcs an expression calls included."""
 
 MAX_BLOCK_NESTING = 50
 """Levels of ``{ }`` blocks, ``{ }*`` repeat groups and ``[ ]`` brackets inside one rule."""
+
+
+_LEAVES = (n.Number, n.String, n.Bool, n.Name)
 
 
 def children(e) -> list:
@@ -127,19 +129,21 @@ def steps_in(rule: n.Rule) -> Iterator[tuple[object, int]]:
 def nesting_problem(item) -> tuple[n.Pos, str, str] | None:
     """(place, message, hint) when a declaration or rule nests deeper than the limits allow."""
     if isinstance(item, n.Rule):
-        deepest, first = 0, cast(Any, None)
+        deepest, first = 0, None
         for node, level in steps_in(item):
             if level > deepest:
                 deepest = level
             if level > MAX_BLOCK_NESTING and first is None:
-                first = node
+                first = node.pos  # type: ignore[attr-defined]
         if first is not None:
             return (
-                first.pos,
+                first,
                 f"blocks nested too deeply ({deepest} levels; at most {MAX_BLOCK_NESTING})",
                 "move the inner blocks into a rule of their own",
             )
     for e in expressions(item):
+        if isinstance(e, _LEAVES):  # most arguments: no walk needed
+            continue
         depth = expr_depth(e)
         if depth > MAX_NESTING:
             return (
