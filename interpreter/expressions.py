@@ -283,9 +283,6 @@ class Compiler:
                 return a + b
             try:
                 result = fn(_num(module, pos, a), _num(module, pos, b))
-                # 1e308 * 10 is inf for floats, and floor(1e308) ** 2 an int no float can hold:
-                # a value no operation can use, so it stops here, at its expression
-                finite = isinstance(result, complex) or math.isfinite(result)
             except ZeroDivisionError:
                 raise runtime_error(
                     module, pos, "division by zero", "guard the divisor, e.g. x / max(n, 1)"
@@ -294,8 +291,6 @@ class Compiler:
                 raise runtime_error(module, pos, "the result is too large") from None
             if isinstance(result, complex):
                 raise runtime_error(module, pos, "a negative number to a fractional power")
-            if not finite:
-                raise runtime_error(module, pos, "the result is too large")
             return result
 
         return arith

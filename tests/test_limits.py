@@ -206,15 +206,3 @@ def test_cli_reports_deep_input_without_internal_error(command, tmp_path, capsys
     err = capsys.readouterr().err
     assert "deep.bgr:1:10: error: expression nested too deeply" in err
     assert "internal error" not in err
-
-
-# ---- arithmetic stays finite ---------------------------------------------------------------
-
-
-@pytest.mark.parametrize(
-    "expr", ["1e308 * 10", "-1e308 - 1e308", "1e308 / 1e-10", "floor(1e308) * floor(1e308)"]
-)
-def test_overflowing_arithmetic_is_a_located_error(expr):
-    with pytest.raises(BgrError, match="the result is too large") as e:
-        derive(LOT.format(expr))
-    assert (e.value.line, e.value.column) == (1, 17)
