@@ -15,6 +15,7 @@ from pathlib import Path
 from . import nodes as n
 from .errors import Diagnostic, source_line, suggest
 from .formatter import format_params
+from .limits import MAX_NESTING, children, expr_depth, expressions
 from .registry import (
     AXES,
     AXIS,
@@ -76,6 +77,9 @@ class Grammar:
     # the folders its imports and assets may resolve in (grammar/paths.py), set by bgr.load;
     # empty (a Grammar made by hand) leaves its assets unchecked
     roots: tuple[Path, ...] = ()
+    # levels of each func's body, the bodies of the funcs it calls included (grammar.limits)
+    func_depths: dict[str, int] = field(default_factory=dict)
+    recursive_funcs: set[str] = field(default_factory=set)  # funcs that call themselves
 
     def lookup_module(self, dotted: str) -> tuple[Grammar, str]:
         """Split ``alias.Name`` into (module, member); a plain name is this module's own."""
@@ -125,6 +129,7 @@ class Checker:
             elif isinstance(item, n.Rule):
                 self.rule(item)
         self.value_cycles()
+        self.call_nesting()
         return self.diagnostics
 
     # ---- declarations ---------------------------------------------------------------------
@@ -734,6 +739,88 @@ class Checker:
                     state[child] = 1
                     stack.append((child, iter(sorted(deps[child]))))
                     path.append(child)
+
+    def call_depth(self, name: str) -> int:
+        """The levels a call of ``name`` adds: its func's body; 0 for a built-in, or a func whose
+        depth is not known yet (it calls itself: that is bounded while deriving)."""
+        module, member = self.g.lookup_module(name)
+        return max(module.func_depths.get(member, 0), 0)
+
+    def reported(self, e) -> bool:
+        """Does ``e`` call a func whose nesting was already reported as too deep (depth -1)?"""
+        for name in _calls_in(e):
+            module, member = self.g.lookup_module(name)
+            if module.func_depths.get(member) == -1:
+                return True
+        return False
+
+    def call_nesting(self) -> None:
+        """Nesting through func calls (grammar.limits): each func's body with the bodies of the
+        funcs it calls, then every expression that calls a func.  Funcs are worked out callees
+        first, with a stack; a func that calls itself, directly or not, is marked recursive."""
+        g = self.g
+        calls = {name: _calls_in(f.body) for name, f in g.funcs.items()}
+        state: dict[str, int] = {}
+        for root in g.funcs:
+            if root in state:
+                continue
+            state[root] = 1
+            path, pending = [root], [iter(calls[root])]
+            while pending:
+                callee = next(pending[-1], None)
+                if callee is None:
+                    name = path.pop()
+                    pending.pop()
+                    state[name] = 2
+                    self.func_nesting(name)
+                elif callee not in g.funcs:
+                    continue
+                elif state.get(callee) == 1:
+                    g.recursive_funcs.update(path[path.index(callee) :])
+                elif callee not in state:
+                    state[callee] = 1
+                    path.append(callee)
+                    pending.append(iter(calls[callee]))
+        if not any(m.func_depths for m in [g, *g.imports.values()]):
+            return
+        for item in g.module.items:
+            if isinstance(item, n.Func):
+                continue
+            for e in expressions(item):
+                if _calls_in(e) and not self.reported(e):
+                    self.too_deep(e, expr_depth(e, self.call_depth))
+
+    def func_nesting(self, name: str) -> None:
+        """A func too deep is reported once: its callers are marked (-1) without a message."""
+        body = self.g.funcs[name].body
+        if self.reported(body):
+            self.g.func_depths[name] = -1
+            return
+        depth = expr_depth(body, self.call_depth)
+        self.g.func_depths[name] = -1 if self.too_deep(body, depth) else depth
+
+    def too_deep(self, e, depth: int) -> bool:
+        if depth <= MAX_NESTING:
+            return False
+        self.error(
+            e.pos,
+            f"expression nested too deeply ({depth} levels with the funcs it calls; "
+            f"at most {MAX_NESTING})",
+            "every level of a called func's body counts: compute parts in attrs or consts, "
+            "or hand them to a rule as parameters",
+        )
+        return True
+
+
+def _calls_in(e) -> list[str]:
+    """The names called in an expression (built-ins included), without recursion."""
+    out, stack = [], [e]
+    while stack:
+        node = stack.pop()
+        if isinstance(node, n.Call):
+            out.append(node.name)
+        stack += children(node)
+    return out
 
 
 def _article(what: str) -> str:

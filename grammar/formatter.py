@@ -105,27 +105,43 @@ def format_expr(e) -> str:
             inner = f"({inner})"
         return f"not {inner}" if e.op == "not" else f"{e.op}{inner}"
     if isinstance(e, n.Binary):
-        p = _LEVEL[e.op]
-        left, right = format_expr(e.left), format_expr(e.right)
-        ll, rl = _level(e.left), _level(e.right)
-        left_paren = ll <= p if (e.op == "**" or p == 4) else ll < p
-        if _is_signed(e.right):  # a prefix minus opens a term of its own: a * -b, a ** -b
+        return _format_chain(e)
+    if isinstance(e, n.Ternary):
+        parts = []
+        while isinstance(e, n.Ternary):  # the else spine in a loop: it can be long
+            cond = format_expr(e.cond)
+            if _level(e.cond) == 0:
+                cond = f"({cond})"
+            parts.append(f"{cond} ? {format_expr(e.then)} : ")
+            e = e.otherwise
+        return "".join(parts) + format_expr(e)
+    raise TypeError(f"not an expression: {e!r}")
+
+
+def _format_chain(e: n.Expr) -> str:
+    """A binary operator with the fewest parentheses; the left spine of a chain
+    (``1 + 2 + ... + n``) in a loop, so that its length costs no stack.  A parenthesis around a
+    left operand always opens at the very start of the text, so only their count is kept."""
+    spine = []
+    while isinstance(e, n.Binary):
+        spine.append(e)
+        e = e.left
+    parts, opens = [format_expr(e)], 0
+    for node in reversed(spine):
+        p = _LEVEL[node.op]
+        ll, rl = _level(node.left), _level(node.right)
+        if ll <= p if (node.op == "**" or p == 4) else ll < p:
+            opens += 1
+            parts.append(")")
+        right = format_expr(node.right)
+        if _is_signed(node.right):  # a prefix minus opens a term of its own: a * -b, a ** -b
             right_paren = False
-        elif isinstance(e.right, n.Unary):  # `not`: only `and` and `or` can take it bare
+        elif isinstance(node.right, n.Unary):  # `not`: only `and` and `or` can take it bare
             right_paren = p > 2
         else:
-            right_paren = rl < p if e.op == "**" else rl <= p
-        if left_paren:
-            left = f"({left})"
-        if right_paren:
-            right = f"({right})"
-        return f"{left} {e.op} {right}"
-    if isinstance(e, n.Ternary):
-        cond = format_expr(e.cond)
-        if _level(e.cond) == 0:
-            cond = f"({cond})"
-        return f"{cond} ? {format_expr(e.then)} : {format_expr(e.otherwise)}"
-    raise TypeError(f"not an expression: {e!r}")
+            right_paren = rl < p if node.op == "**" else rl <= p
+        parts.append(f" {node.op} ({right})" if right_paren else f" {node.op} {right}")
+    return "(" * opens + "".join(parts)
 
 
 def _is_signed(e) -> bool:

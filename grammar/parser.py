@@ -19,6 +19,7 @@ from lark.exceptions import UnexpectedCharacters, UnexpectedEOF, UnexpectedInput
 
 from . import nodes as n
 from .errors import BgrSyntaxError, Diagnostic, source_line, source_lines, suggest
+from .limits import nesting_problem
 from .registry import KEYWORDS, OPERATIONS
 
 GRAMMAR_FILE = Path(__file__).with_name("bgr.lark")
@@ -351,7 +352,7 @@ class _TreeBuilder(Transformer):
                 stream.extend(part)
         if len(stream) == 1:
             return stream[0]
-        return _Pratt(stream).parse()
+        return _order(stream)
 
 
 # Binding powers: (left, right).  Left-associative operators bind tighter on the right.
@@ -375,46 +376,55 @@ _PREFIX = {"not": 5, "-": 13, "+": 13}  # right binding power of each prefix ope
 _COMPARISONS = {"==", "!=", "<", "<=", ">", ">="}
 
 
-class _Pratt:
+def _order(stream: list) -> n.Expr:
     """Orders a flat operator chain by precedence, as Python does: ``or`` < ``and`` < ``not`` <
-    comparisons < ``+ -`` < ``* / %`` < unary ``- +`` < ``**`` (right-associative)."""
+    comparisons < ``+ -`` < ``* / %`` < unary ``- +`` < ``**`` (right-associative).
 
-    def __init__(self, stream: list) -> None:
-        self.stream, self.i = stream, 0
+    An operator-precedence (shunting-yard) loop with the binding powers above, not a recursive
+    descent: a chain of a thousand prefix minuses or ``**`` must not exhaust Python's stack
+    before the nesting limit (:mod:`limits`) can report it.
+    """
+    operands: list = []
+    pending: list[tuple[Token, int, bool]] = []  # (operator, right binding power, is prefix)
 
-    def parse(self, min_bp: int = 0):
-        tok = self.stream[self.i]
-        self.i += 1
-        left: n.Expr
-        if isinstance(tok, Token):  # a prefix operator
-            operand = self.parse(_PREFIX[str(tok)])
-            if str(tok) == "-" and isinstance(operand, n.Number):  # -0.25 is a number literal
-                left = n.Number(-operand.value, pos=_span(tok, operand))
+    def reduce(incoming: Token | None) -> None:
+        tok, _, prefix = pending.pop()
+        op = str(tok)
+        if prefix:
+            operand = operands.pop()
+            if op == "-" and isinstance(operand, n.Number):  # -0.25 is a number literal
+                operands.append(n.Number(-operand.value, pos=_span(tok, operand)))
             else:
-                left = n.Unary(str(tok), operand, pos=_span(tok, operand))
-        else:
-            left = tok
-        while self.i < len(self.stream):
-            op = self.stream[self.i]
-            lbp, rbp = _INFIX[str(op)]
-            if lbp < min_bp:
-                break
-            self.i += 1
-            right = self.parse(rbp)
-            if (
-                str(op) in _COMPARISONS
-                and self.i < len(self.stream)
-                and str(self.stream[self.i]) in _COMPARISONS
-            ):
-                nxt = self.stream[self.i]
-                raise _Problem(
-                    _tok_pos(nxt),
-                    f"comparisons cannot be chained: '{op}' then '{nxt}'",
-                    "write 'a < b and b < c'",
-                    len(nxt),
-                )
-            left = n.Binary(str(op), left, right, pos=_span(left, right))
-        return left
+                operands.append(n.Unary(op, operand, pos=_span(tok, operand)))
+            return
+        if incoming is not None and op in _COMPARISONS and str(incoming) in _COMPARISONS:
+            raise _Problem(
+                _tok_pos(incoming),
+                f"comparisons cannot be chained: '{op}' then '{incoming}'",
+                "write 'a < b and b < c'",
+                len(incoming),
+            )
+        right = operands.pop()
+        left = operands.pop()
+        operands.append(n.Binary(op, left, right, pos=_span(left, right)))
+
+    want_operand = True
+    for item in stream:
+        if want_operand:
+            if isinstance(item, Token):  # a prefix operator
+                pending.append((item, _PREFIX[str(item)], True))
+            else:
+                operands.append(item)
+                want_operand = False
+            continue
+        lbp, rbp = _INFIX[str(item)]
+        while pending and pending[-1][1] > lbp:
+            reduce(item)
+        pending.append((item, rbp, False))
+        want_operand = True
+    while pending:
+        reduce(None)
+    return operands[0]
 
 
 def _number(tok: Token) -> float:
@@ -516,6 +526,7 @@ def parse(text: str, path: str = "<text>") -> n.Module:
             raise _translate(e, text, path) from None
         tokens = _comments.tokens
         _comments.tokens = []
+    _check_nesting(items, text, path)
     comments = []
     lines = source_lines(text)
     for tok in tokens:
@@ -523,6 +534,18 @@ def parse(text: str, path: str = "<text>") -> n.Module:
         before = lines[line - 1][: column - 1] if line <= len(lines) else ""
         comments.append(n.Comment(str(tok).rstrip(), line, column, not before.strip()))
     return n.Module(items, path=path, comments=comments, source=text)
+
+
+def _check_nesting(items: list[n.Item], text: str, path: str) -> None:
+    """Nesting deeper than :mod:`limits` allows is a syntax error, so that check, fmt and derive
+    all stop at the same place before anything walks the tree recursively."""
+    for item in items:
+        problem = nesting_problem(item)
+        if problem is not None:
+            pos, message, hint = problem
+            raise BgrSyntaxError(
+                Diagnostic(path, pos.line, pos.column, message, hint, source_line(text, pos.line))
+            )
 
 
 # ---- error translation --------------------------------------------------------------------------

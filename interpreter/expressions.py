@@ -205,30 +205,67 @@ class Compiler:
                 return lambda ctx: -_num(module, e.pos, f(ctx))
             return lambda ctx: +_num(module, e.pos, f(ctx))
         if isinstance(e, n.Ternary):
-            c, a, b = (
-                self.expr(e.cond, local),
-                self.expr(e.then, local),
-                self.expr(e.otherwise, local),
-            )
-            return lambda ctx: a(ctx) if c(ctx) else b(ctx)
+            return self.ternary(e, local)
         if isinstance(e, n.Binary):
             return self.binary(e, local)
         if isinstance(e, n.Call):
             return self.call(e, local)
         raise TypeError(f"not an expression: {e!r}")
 
+    def ternary(self, e: n.Ternary, local: frozenset) -> Compiled:
+        """``c1 ? a : c2 ? b : d``: the else spine is one loop, however long (grammar.limits)."""
+        branches = []
+        while isinstance(e, n.Ternary):
+            branches.append((self.expr(e.cond, local), self.expr(e.then, local)))
+            e = e.otherwise
+        last = self.expr(e, local)
+        if len(branches) == 1:
+            (c, a) = branches[0]
+            return lambda ctx: a(ctx) if c(ctx) else last(ctx)
+
+        def pick(ctx):
+            for c, a in branches:
+                if c(ctx):
+                    return a(ctx)
+            return last(ctx)
+
+        return pick
+
     def binary(self, e: n.Binary, local: frozenset) -> Compiled:
+        """An operator chain: the left spine (``1 + 2 - 3 + ...``, ``a and b and c``) is one
+        loop, however long, so its length costs no stack (grammar.limits)."""
+        spine = []
+        while isinstance(e, n.Binary):
+            spine.append(e)
+            e = e.left
+        spine.reverse()  # innermost first: the order of evaluation
+        leaf = self.expr(e, local)
+        steps = [(self.combiner(node), self.expr(node.right, local)) for node in spine]
+        if len(steps) == 1:
+            ((combine, right),) = steps
+            return lambda ctx: combine(leaf(ctx), right, ctx)
+
+        def chain(ctx):
+            value = leaf(ctx)
+            for combine, right in steps:
+                value = combine(value, right, ctx)
+            return value
+
+        return chain
+
+    def combiner(self, e: n.Binary) -> Callable[[Value, Compiled, Context], Value]:
+        """``combine(a, right, ctx)``: ``a op right(ctx)``; ``and``/``or`` evaluate the right
+        side only when they need it."""
         module, pos = self.module, e.pos
-        left, right = self.expr(e.left, local), self.expr(e.right, local)
         if e.op == "and":
-            return lambda ctx: left(ctx) and right(ctx)
+            return lambda a, right, ctx: right(ctx) if a else a
         if e.op == "or":
-            return lambda ctx: left(ctx) or right(ctx)
+            return lambda a, right, ctx: a if a else right(ctx)
         if e.op in _COMPARE:
             cmp = _COMPARE[e.op]
 
-            def compare(ctx):
-                a, b = left(ctx), right(ctx)
+            def compare(a, right, ctx):
+                b = right(ctx)
                 try:
                     return cmp(a, b)
                 except TypeError:
@@ -240,8 +277,8 @@ class Compiler:
         fn = _ARITH[e.op]
         op = e.op
 
-        def arith(ctx):
-            a, b = left(ctx), right(ctx)
+        def arith(a, right, ctx):
+            b = right(ctx)
             if op == "+" and isinstance(a, str) and isinstance(b, str):
                 return a + b
             try:
@@ -306,9 +343,13 @@ class Compiler:
         return compiler.func_call(member, args, module, pos)
 
     def func_call(self, name: str, args: list[Compiled], caller, pos) -> Compiled:
+        """A call of the func ``name``.  The checker bounds the nesting of funcs that do not call
+        themselves (grammar.limits); a recursion's depth is only known while deriving, so there,
+        and only there, Python's recursion limit is what stops it, with a located error."""
         func = self.module.funcs[name]
         params = func.params
         holder = self.funcs
+        recursive = name in self.module.recursive_funcs
 
         def call(ctx):
             body = holder.get(name)
@@ -320,8 +361,13 @@ class Compiler:
             try:
                 return body(ctx)
             except RecursionError:
+                if not recursive:
+                    raise
                 raise runtime_error(
-                    caller, pos, f"function '{name}' calls itself without end"
+                    caller,
+                    pos,
+                    f"function '{name}' calls itself too deeply (without end?)",
+                    "a func may call itself a few hundred levels deep at most",
                 ) from None
             finally:
                 ctx.args = saved
@@ -347,16 +393,11 @@ def evaluate_values(
     pending = {**grammar.attrs, **grammar.consts}
     ctx = Context(None, {}, None, seed)
 
-    def get(name):
-        if name in values:
-            return values[name]
+    def compute(name):
         if name in grammar.attrs and name in overrides:
             values[name] = overrides[name]
         else:
             item = pending[name]
-            for dep in n.names_in(item.value):
-                if dep.name in pending:
-                    get(dep.name)
             ctx.stream = Stream(
                 child_hash(
                     root_hash(seed), name_hash(Path(grammar.path).stem + "." + name), lot_index
@@ -372,10 +413,20 @@ def evaluate_values(
                     "function, but attrs and consts are evaluated before any shape exists",
                     "compute it in a rule instead",
                 ) from None
-        return values[name]
 
-    for name in pending:
-        get(name)
+    for root in pending:  # dependencies first, with a stack: a long chain of attrs is no recursion
+        stack = [(root, False)]
+        while stack:
+            name, ready = stack.pop()
+            if name in values:
+                continue
+            if ready:
+                compute(name)
+                continue
+            stack.append((name, True))
+            if not (name in grammar.attrs and name in overrides):
+                deps = n.names_in(pending[name].value)
+                stack += ((d.name, False) for d in deps if d.name in pending)
     return values
 
 

@@ -1,3 +1,4 @@
+import os
 from pathlib import Path
 
 import pytest
@@ -16,3 +17,20 @@ def shipped_grammars() -> list[Path]:
 @pytest.fixture
 def root() -> Path:
     return ROOT
+
+
+def pytest_addoption(parser: pytest.Parser) -> None:
+    parser.addoption(
+        "--fuzz-cases",
+        type=int,
+        default=None,
+        help="examples per fuzz test in tests/test_fuzz.py (nightly: 100000); default: each "
+        "test's own small count",
+    )
+
+
+def pytest_configure(config: pytest.Config) -> None:
+    # test_fuzz.py reads it when it is imported, to size its hypothesis settings
+    cases = config.getoption("--fuzz-cases")
+    if cases:
+        os.environ["BGR_FUZZ_CASES"] = str(cases)

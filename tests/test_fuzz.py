@@ -57,9 +57,14 @@ SHIPPED = REPO_GRAMMARS + ([BENCH] if BENCH.is_file() else [])
 SHIPPED_TEXT = {p: p.read_text(encoding="utf-8") for p in SHIPPED}
 
 
+# `pytest tests/test_fuzz.py --fuzz-cases 100000` (tests/conftest.py) sizes every test here: the
+# nightly run.  Without it each test keeps its own small count, so that CI stays fast.
+FUZZ_CASES = int(os.environ.get("BGR_FUZZ_CASES") or 0)
+
+
 def fuzz_settings(max_examples: int, **extra):
     return settings(
-        max_examples=max_examples,
+        max_examples=FUZZ_CASES or max_examples,
         deadline=None,
         database=None,
         suppress_health_check=[
@@ -1299,3 +1304,200 @@ def test_generated_grammars_derive_or_fail_cleanly(case):
         bgr.derive(grammar, seed=1, lot=(10, 8), max_shapes=3000, max_depth=25)
     except BgrError as e:
         assert e.message
+
+
+# ---- 6. hostile mutations of real grammars, through derive and every writer ---------------------
+# Token-level mutations of the shipped grammars (a number replaced by a hostile one, tokens
+# duplicated or deleted, a number nested deep in parentheses, prefix minuses or calls) are loaded,
+# derived on a small lot with small budgets, and written as glb, obj and json.  Only BgrError may
+# come out, and each case must finish in CASE_SECONDS.
+
+CASE_SECONDS = 10.0
+_TOKEN = re.compile(
+    r'"(?:\\.|[^"\\\n])*"|#[^\n]*|(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?|[A-Za-z_][\w.]*|-->|\*\*'
+    r"|[=!<>]=|\s+|.",
+    re.S,
+)
+_IS_NUMBER = re.compile(r"(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?\Z")
+HOSTILE_NUMBERS = [
+    "1e308*10",
+    "1e400",
+    "-0",
+    "0/0",
+    "(0/0)",
+    "1e308",
+    "-1e308",
+    "99999999999999999999999999",
+    "2**1024",
+    "(-1)**0.5",
+    "1e308*1e308-1e308*1e308",
+    "1e-300",
+    "5e-324",
+    "0.000000001",
+    "1e-9*scope.sx",
+    "0",
+    "-1",
+    "1e15",
+    "1e9",
+]
+HOSTILE_EXPRESSIONS = [
+    "rand(1e308)",
+    "scope.sx*1e300",
+    "1/scope.sx",
+    "split.index*1e308",
+    "-scope.sz",
+    "randint(0, 1e18)",
+    "floor(1e308)",
+    "sqrt(-1)",
+    "comp.index/comp.total",
+]
+_WRAPPERS = ["(", "-(", "min(1e308, ", "abs(", "f(", "not ("]
+_DEPTHS = [1, 5, 50, 98, 99, 100, 101, 150, 1000]
+
+
+class CaseTimeout(Exception):
+    """A fuzz case ran longer than CASE_SECONDS: a hang, as far as the contract goes."""
+
+
+@contextlib.contextmanager
+def time_limit(seconds: float):
+    """Raise CaseTimeout in the main thread once ``seconds`` have passed (SIGALRM, POSIX only)."""
+    import signal
+
+    if not hasattr(signal, "setitimer"):  # pragma: no cover - Windows: no timer
+        yield
+        return
+
+    def expire(signum, frame):
+        raise CaseTimeout(f"the case took more than {seconds:g} s")
+
+    previous = signal.signal(signal.SIGALRM, expire)
+    signal.setitimer(signal.ITIMER_REAL, seconds)
+    try:
+        yield
+    finally:
+        signal.setitimer(signal.ITIMER_REAL, 0)
+        signal.signal(signal.SIGALRM, previous)
+
+
+@st.composite
+def hostile_mutations(draw) -> tuple[Path, str]:
+    """(the shipped grammar, its text after one to three token-level mutations)."""
+    path = draw(st.sampled_from(REPO_GRAMMARS))
+    toks = _TOKEN.findall(SHIPPED_TEXT[path])
+    for _ in range(draw(st.integers(1, 3))):
+        numbers = [i for i, t in enumerate(toks) if _IS_NUMBER.match(t)]
+        kind = draw(st.sampled_from(["number", "number", "expr", "nest", "dup", "del"]))
+        if kind == "dup" or not numbers:
+            i = draw(st.integers(0, len(toks) - 1))
+            toks.insert(i, toks[i])
+            continue
+        if kind == "del":
+            del toks[draw(st.integers(0, len(toks) - 1))]
+            continue
+        i = draw(st.sampled_from(numbers))
+        if kind == "number":
+            toks[i] = draw(st.sampled_from(HOSTILE_NUMBERS))
+        elif kind == "expr":
+            toks[i] = draw(st.sampled_from(HOSTILE_EXPRESSIONS))
+        else:
+            depth, wrap = draw(st.sampled_from(_DEPTHS)), draw(st.sampled_from(_WRAPPERS))
+            toks[i] = wrap * depth + toks[i] + ")" * depth
+    return path, "".join(toks)
+
+
+# Failure classes outside the front end (geometry, writers, budgets), found by this fuzzing and
+# being fixed elsewhere: (stage, exception type).  They are reported as warnings, not failures,
+# so that CI stays green; remove an entry when its fix lands.
+KNOWN_OUTSIDE: dict[tuple[str, str], str] = {}
+# Found by it and since fixed on main (each now a located BgrError): offset(-1e308) (GEOS
+# orientationIndex), roof(gable, 30, 1e15) (numpy min of an empty array), s('1e308, 0, '1) then
+# split(x) { 1: A }* (int(inf) in split_solver.py) or center(xz) (int(NaN) in polygons.py), and
+# offset(1e308 * 10) (shapely: buffer distance must be finite).
+
+
+def derive_and_write(text: str, path: Path, out: Path) -> None:
+    """load, fmt, a bounded derive, and the three writers: BgrError or success, in time."""
+    from bgr.interpreter.writers import write
+
+    stage = "load"
+    try:
+        with time_limit(CASE_SECONDS):
+            grammar = bgr.load(text, path=str(path))
+            stage = "fmt"
+            format_source(text)
+            stage = "derive"
+            result = bgr.derive(grammar, seed=3, lot=(12, 9), max_shapes=2000, max_depth=40)
+            for ext in ("glb", "obj", "json"):
+                stage = ext
+                write(result.terminals, out / f"out.{ext}", seed=result.seed, attrs=result.attrs)
+    except BgrError as e:
+        assert e.diagnostics
+        e.render()
+    except Exception as e:
+        known = KNOWN_OUTSIDE.get((stage, type(e).__name__))
+        if known is None:
+            raise
+        import warnings
+
+        warnings.warn(f"known fuzz failure ({stage}, {type(e).__name__}): {known}", stacklevel=1)
+
+
+def test_hostile_mutations_of_real_grammars_derive_or_fail_cleanly(tmp_path):
+    @fuzz_settings(40)
+    @given(hostile_mutations())
+    def run(case):
+        path, text = case
+        note(f"{path.name}: {text!r}")
+        with warnings_as_notes():
+            derive_and_write(text, path.with_name("fuzz.bgr"), tmp_path)
+
+    run()
+
+
+@contextlib.contextmanager
+def warnings_as_notes():
+    """numpy's overflow RuntimeWarnings are the writers' business; they must not fail a case."""
+    import warnings
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)
+        yield
+
+
+_DEEP_FORMS = {
+    "parens": ("(1 + ", ")"),
+    "minus": ("-", ""),
+    "not": ("not ", ""),
+    "power": ("2 ** ", ""),
+    "call": ("min(1, ", ")"),
+    "then": ("true ? ", " : 2"),
+}
+
+
+@fuzz_settings(30)
+@given(
+    st.sampled_from(sorted(_DEEP_FORMS)),
+    st.sampled_from(_DEPTHS + [10_000]),
+    st.sampled_from(
+        [
+            "attr a = {}\nLot --> extrude(a)",
+            "Lot --> extrude({})",
+            "Lot --> s({}, 1, 1)",
+        ]
+    ),
+)
+def test_deep_expressions_are_accepted_everywhere_or_rejected_everywhere(form, depth, where):
+    """check, fmt and derive agree on nesting (docs/language.md, "Nesting limits")."""
+    opening, closing = _DEEP_FORMS[form]
+    text = where.format(opening * depth + "(seed + 1)" + closing * depth) + "\n"
+    try:
+        grammar = bgr.load(text)
+    except BgrError as e:
+        assert "nested too deeply" in e.message
+        with pytest.raises(BgrError, match="nested too deeply"):
+            format_source(text)
+        return
+    format_source(text)
+    with warnings_as_notes(), contextlib.suppress(BgrError):
+        bgr.derive(grammar, lot=(5, 5), max_shapes=2000)
