@@ -86,7 +86,9 @@ REPRODUCERS = {
     "offset_outward": ("Lot --> offset(-1e9) { border: T }", "", "'offset' makes a scope"),
     "circle_inf": ("Lot --> footprint(circle, 1e308 * 10)", "", "'footprint' argument 2 is inf"),
     "taper_ratio": ("Lot --> taper(3, 1e300)", "", "'taper' argument 2 is 1e+300"),
-    "roof_overhang": ("Lot --> roof(gable, 30, 1e9)", "", "'roof' makes a scope of 2e+09 m"),
+    "roof_overhang": ("Lot --> roof(gable, 30, 1e9)", "", "more than ten times the footprint"),
+    # found by the fuzzer: float error ate the whole roof, then min() of nothing
+    "roof_overhang_3e8": ("Lot --> roof(gable, 35, 3e8)", "--lot 12,9", "an overhang of 3e+08 m"),
 }
 
 

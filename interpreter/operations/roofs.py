@@ -44,6 +44,14 @@ def roof(app, shape, step, args) -> bool:
         geom, _ = _into_extrusion_frame(app, step, shape, "face.normal", 0.0)
     k = geom.k
     p, q = PLANE_AXES[k]
+    widest = max(shape.size[p], shape.size[q])
+    if overhang > 10 * widest:  # past this, float error eats the roof (and no roof is built so)
+        raise runtime_error(
+            app.module,
+            step.pos,
+            f"an overhang of {overhang:g} m is more than ten times the footprint ({widest:g} m)",
+            "an overhang is the eaves' reach past the walls, usually under 2 m",
+        )
     polys = [(UNIT_SQUARE, ())] if geom.polys == RECT else geom.polys
     verts, faces = [], []
     base = 0
@@ -73,6 +81,10 @@ def roof(app, shape, step, args) -> bool:
     scoped[:, p], scoped[:, q], scoped[:, k] = local[:, 0], local[:, 1], local[:, 2]
     if (p, q, k) in ((0, 2, 1), (2, 1, 0), (1, 0, 2)):
         tris = tris[:, ::-1]
+    if not len(scoped):
+        raise runtime_error(
+            app.module, step.pos, f"the {kind} roof on this footprint has no faces left"
+        )
     lo, hi = scoped.min(axis=0), scoped.max(axis=0)
     extent = hi - lo
     unit = (scoped - lo) / np.where(extent > 0, extent, 1.0)
