@@ -143,3 +143,9 @@ def read_json(path, what: str, hint: str | None = None):
         raise BgrError(
             Diagnostic(shown, exc.lineno, exc.colno, f"not valid JSON: {exc.msg}")
         ) from None
+    except ValueError as exc:  # an integer of more digits than Python converts (4,300)
+        raise BgrError(Diagnostic(shown, 0, 0, f"not usable JSON: {exc}")) from None
+    except RecursionError:
+        raise BgrError(
+            Diagnostic(shown, 0, 0, "not usable JSON: it nests arrays or objects too deeply")
+        ) from None
