@@ -50,8 +50,26 @@ class FootprintError(ValueError):
 
 
 def rectangle(width: float, depth: float) -> Lot:
-    if not (width > 0 and depth > 0 and math.isfinite(width) and math.isfinite(depth)):
-        raise BgrError(f"--lot {width:g},{depth:g}: a lot needs a positive width and depth")
+    """A W x D lot; each side must be a number over 0 and at most MAX_COORDINATE metres."""
+    sides = []
+    for side in (width, depth):
+        try:
+            sides.append(float(side))
+        except OverflowError:  # an int of more than about 309 digits
+            sides.append(math.inf)
+    width, depth = sides
+    if not all(0 < side <= MAX_COORDINATE for side in sides):  # also refuses nan
+        limit = f"{MAX_COORDINATE:.0e}".replace("e+0", "e")
+        raise BgrError(
+            Diagnostic(
+                "",
+                0,
+                0,
+                f"--lot {width:g},{depth:g}: a lot needs a width and depth over 0 and at most "
+                f"{limit} metres",
+                "write the lot as WIDTH,DEPTH in metres, e.g. 20,30",
+            )
+        )
     return Lot(Shape((0.0, 0.0, 0.0), IDENTITY, (width, 0.0, depth), Flat(1, RECT)))
 
 
@@ -86,14 +104,13 @@ def footprint(
 def parse_lot_option(value: str, warnings: Warnings | None = None) -> list[Lot]:
     """``W,D`` or a GeoJSON file of footprints."""
     if "," in value and not value.lower().endswith((".json", ".geojson")):
-        try:
-            width, depth = (float(v) for v in value.split(","))
-        except ValueError:
+        sides = [number_of(v) for v in value.split(",")]  # ASCII numbers only, as in .bgr
+        if len(sides) != 2 or sides[0] is None or sides[1] is None:  # "nan", "1_0", "1e400"
             raise BgrError(
-                f"--lot {value}: write the lot as WIDTH,DEPTH in metres (e.g. 20,30) "
-                "or give a GeoJSON file"
-            ) from None
-        return [rectangle(width, depth)]
+                f"--lot {value[:60]}: write the lot as WIDTH,DEPTH, two numbers in metres "
+                "(e.g. 20,30), or give a GeoJSON file"
+            )
+        return [rectangle(sides[0], sides[1])]
     return read_geojson(Path(value), warnings)
 
 

@@ -23,7 +23,7 @@ SEED_RANGE = (-(2**63), 2**64 - 1)
 
 # the number syntax of the .bgr language (grammar/bgr.lark, NUMBER) with an optional sign, in
 # ASCII only: Python's float() also takes "1_000", "inf", "nan" and non-ASCII digits ("١٠")
-_NUMBER = re.compile(r"[+-]?(?:[0-9]+(?:\.[0-9]*)?|\.[0-9]+)(?:[eE][+-]?[0-9]+)?", re.ASCII)
+NUMBER_SYNTAX = re.compile(r"[+-]?(?:[0-9]+(?:\.[0-9]*)?|\.[0-9]+)(?:[eE][+-]?[0-9]+)?", re.ASCII)
 _INTEGER = re.compile(r"[+-]?[0-9]+", re.ASCII)
 
 
@@ -32,7 +32,7 @@ def number_of(text: str) -> int | float | None:
     allowed — or None: no digit separators (``"1_000"``), no non-ASCII digits, no ``inf`` or
     ``nan``, nothing that overflows (``"1e400"``)."""
     text = text.strip()
-    if not _NUMBER.fullmatch(text):
+    if not NUMBER_SYNTAX.fullmatch(text):
         return None
     value = float(text)  # before int(): int() of 5,000 digits is an error, float() is inf
     if not math.isfinite(value):
