@@ -84,6 +84,10 @@ def derive(
     starts).  Passing one of them raises a located :class:`bgr.BgrError`; see docs/limits.md.
 
     ``allow_paths`` is passed to :func:`bgr.load` when ``grammar`` is not loaded yet.
+
+    Every argument is checked before anything is derived (docs/cli.md, "Values from outside"):
+    a seed outside -2**63 .. 2**64 - 1, limits under 1, attrs that are not finite numbers of at
+    most 1e9, booleans or strings, or a lot of any other form is a :class:`bgr.BgrError`.
     """
     if not isinstance(grammar, Grammar):
         grammar = load(grammar, allow_paths=allow_paths)
@@ -206,16 +210,20 @@ def _lots(lot: object, warnings: Warnings) -> list[Lot]:
         return parse_lot_option(os.fspath(lot), warnings)
     if isinstance(lot, Lot):
         return [lot]
-    if isinstance(lot, (tuple, list)) and all(isinstance(v, Lot) for v in lot):
-        if not lot:
-            raise BgrError("lot is an empty list: there is no lot to derive on")
-        return list(lot)
     if (
         isinstance(lot, (tuple, list))
         and len(lot) == 2
         and all(isinstance(v, Real) and not isinstance(v, bool) for v in lot)
     ):
         return [rectangle(*lot)]
+    try:
+        lots = list(lot)  # any iterable of lots
+    except TypeError:
+        lots = None
+    if lots is not None and all(isinstance(v, Lot) for v in lots):
+        if not lots:
+            raise BgrError("lot is an empty list: there is no lot to derive on")
+        return lots
     raise BgrError(
         f'lot must be (width, depth), a "W,D" string, a GeoJSON path or a list of lots, '
         f"got {_shown(lot)}"
