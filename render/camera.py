@@ -393,11 +393,10 @@ def _from_dict(cls, data: Any, shown: str, size) -> Camera:
         if "size" in data:
             sz = vector("size", 2)
             whole = all(float(v).is_integer() for v in sz)
-            problem = size_problem(int(sz[0]), int(sz[1])) if whole else "whole numbers"
-            if problem:
+            if not whole or size_problem(int(sz[0]), int(sz[1])):
                 raise bad(
-                    f"camera key 'size' must be [width, height] in pixels: {problem}; got "
-                    f"{_json(data['size'])}",
+                    f"camera key 'size' must be two positive whole numbers, 1 to {MAX_SIDE} "
+                    f"each and at most {MAX_PIXELS:,} pixels in all; got {_json(data['size'])}",
                     "--size WxH overrides it",
                 )
             size = (int(sz[0]), int(sz[1]))

@@ -157,10 +157,10 @@ def test_set_numbers(grammar, tmp_path, text, value):
 @pytest.mark.parametrize(
     "camera, message",
     [
-        ({"position": [0, 5, -30], "size": [100000, 100000]}, "each side must be 1 to 8192"),
-        ({"position": [0, 5, -30], "size": [8192, 8192]}, "at most 16,777,216 pixels"),
-        ({"position": [0, 5, -30], "size": [0, 10]}, "each side must be 1 to 8192"),
-        ({"position": [0, 5, -30], "size": [10.5, 10]}, "whole numbers"),
+        ({"position": [0, 5, -30], "size": [100000, 100000]}, "1 to 8192 each"),
+        ({"position": [0, 5, -30], "size": [8192, 8192]}, "at most 16,777,216 pixels in all"),
+        ({"position": [0, 5, -30], "size": [0, 10]}, "two positive whole numbers"),
+        ({"position": [0, 5, -30], "size": [10.5, 10]}, "two positive whole numbers"),
         ({"position": [0, 5, 1e300]}, "'position' must be a list of 3 numbers"),
         ({"position": [0, 5, 10**400]}, "'position' must be a list of 3 numbers"),
         ({"position": [0, 5, -30], "yaw": 10**400}, "'yaw' must be a number"),
