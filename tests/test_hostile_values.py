@@ -259,19 +259,21 @@ def test_a_face_index_must_be_whole(index, message):
 @pytest.mark.parametrize(
     "body, message",
     [
-        ("(big - big)%: X | else: X", "a percentage must be a number from 0 to 100, got nan"),
-        ("(big)%: X | else: X", "the percentages add up to inf%"),
-        ("split(x) { ~(big - big): X | ~1: X }", "a split size must be a finite number"),
-        ("split(x) { ~big: X | ~1: X }", "a split size must be a finite number"),
-        ("split(x) { (big - big): X }*", "a split size must be a finite number"),
+        ("(BIG - BIG)%: X | else: X", "a percentage must be a number from 0 to 100, got nan"),
+        ("(BIG)%: X | else: X", "the percentages add up to inf%"),
+        ("split(x) { ~(BIG - BIG): X | ~1: X }", "a split size must be a finite number"),
+        ("split(x) { ~BIG: X | ~1: X }", "a split size must be a finite number"),
+        ("split(x) { (BIG - BIG): X }*", "a split size must be a finite number"),
         ("extrude(1e400) X", "number 1e400 is too large"),
     ],
 )
 def test_no_non_finite_number_reaches_a_size_or_a_percentage(body, message):
-    source = f"const big = 1e308 * 10\nterminal X\nLot --> {body}\n"
+    """An overflow (BIG is inf) is refused where it is used; a const or attr that overflows is
+    refused where it is declared."""
+    source = f"terminal X\nLot --> {body.replace('BIG', '(1e308 * 10)')}\n"
     with pytest.raises(bgr.BgrError, match=re.escape(message)) as e:
         bgr.derive(source)
-    assert e.value.line == 3
+    assert e.value.line == 2
 
 
 def test_numbers_in_the_language_are_ascii():
