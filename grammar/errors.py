@@ -129,8 +129,8 @@ def suggest(name: str, known: Iterable[str]) -> str | None:
 
 
 def normalise_newlines(source: str) -> str:
-    """``\r\n`` and a lone ``\r`` (old Mac files) made ``\n``, as the parser reads text: so that
-    every reader of a file (check, derive, fmt, messages) agrees where its lines end."""
+    """CRLF and a lone CR (old Mac files) made LF, as the parser reads text: so that every
+    reader of a file (check, derive, fmt, messages) agrees where its lines end."""
     return source.replace("\r\n", "\n").replace("\r", "\n") if "\r" in source else source
 
 

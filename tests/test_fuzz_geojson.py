@@ -7,8 +7,8 @@ list items dropped or repeated, values wrapped in lists or nested deeply, and th
 Each mutant is derived with a grammar that reads a property as an attr, splits the walls and
 puts a roof on, both leniently and with ``strict=True``.
 
-The number of cases is ``BGR_FUZZ_CASES`` (default 300, about 15 s on 2 cores); docs/fuzzing.md
-records a long run.
+The number of cases is ``pytest --fuzz-cases N`` or the environment variable ``BGR_FUZZ_CASES``
+(tests/conftest.py; default 300, about 4 s on 2 cores); docs/fuzzing.md records a long run.
 """
 
 from __future__ import annotations
@@ -25,7 +25,7 @@ from hypothesis import strategies as st
 import bgr
 
 ROOT = Path(__file__).resolve().parent.parent
-CASES = int(os.environ.get("BGR_FUZZ_CASES", "300"))
+CASES = int(os.environ.get("BGR_FUZZ_CASES") or 300)  # pytest --fuzz-cases N sets it
 
 GRAMMAR = bgr.load(
     'attr height = 9\nattr floors = 3\nattr style = "brick"\nattr flat = false\n'
