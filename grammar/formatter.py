@@ -67,7 +67,11 @@ def format_string(value: str) -> str:
     if "\x00" in value:
         raise ValueError("a .bgr string cannot hold a NUL character")
     escaped = (
-        value.replace("\\", "\\\\").replace('"', '\\"').replace("\n", "\\n").replace("\t", "\\t")
+        value.replace("\\", "\\\\")
+        .replace('"', '\\"')
+        .replace("\n", "\\n")
+        .replace("\r", "\\r")
+        .replace("\t", "\\t")
     )
     return f'"{escaped}"'
 

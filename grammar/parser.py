@@ -116,7 +116,8 @@ class _Problem(Exception):
 def _unescape(tok: Token) -> str:
     body = tok[1:-1]
     out, i = [], 0
-    escapes = {'"': '"', "\\": "\\", "n": "\n", "t": "\t"}
+    # \r too: a raw CR ends a line (normalise_newlines), so a string holds one only escaped
+    escapes = {'"': '"', "\\": "\\", "n": "\n", "r": "\r", "t": "\t"}
     while i < len(body):
         c = body[i]
         if c == "\\":
@@ -127,7 +128,7 @@ def _unescape(tok: Token) -> str:
                 raise _Problem(
                     pos,
                     f"unknown escape '\\{nxt}' in a string",
-                    'strings know \\" \\\\ \\n and \\t; write \\\\ for a backslash',
+                    'strings know \\" \\\\ \\n \\r and \\t; write \\\\ for a backslash',
                     2,
                 )
             out.append(escapes[nxt])

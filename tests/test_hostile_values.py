@@ -304,3 +304,11 @@ def test_a_long_string_literal_is_refused_cheaply():
 
 def test_a_string_of_the_limit_is_fine():
     assert bgr.load(f'attr s = "{"a" * 65_536}"\nterminal X\nLot --> X\n')
+
+
+def test_a_carriage_return_in_a_string_is_written_escaped():
+    """A raw CR ends a line, so the formatter writes one inside a string as the escape \\r."""
+    source = 'attr a = "x\\ry"\n'
+    assert bgr.format_source(source) == source
+    (attr,) = bgr.parse(source).items
+    assert attr.value.value == "x\ry"
