@@ -6,6 +6,10 @@ The public Python API::
     grammar = bgr.load("house.bgr")        # parse, resolve imports, check; raises bgr.BgrError
     text = bgr.format_source(open("house.bgr").read())   # canonical layout, comments kept
     result = bgr.derive(grammar, seed=3)     # terminals as a table; result.save("house.glb")
+
+Every bad value, in a file or an argument, is a :class:`BgrError` with a located message
+(docs/cli.md, "Values from outside", gives the ranges).  Only text that is not text at all,
+``load(None)`` or ``format_source(5)``, is a ``TypeError``: a programmer's error, not a user's.
 """
 
 from importlib.metadata import PackageNotFoundError

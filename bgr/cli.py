@@ -11,6 +11,7 @@ from __future__ import annotations
 import argparse
 import contextlib
 import os
+import re
 import signal
 import sys
 import traceback
@@ -91,7 +92,7 @@ def build_parser() -> argparse.ArgumentParser:
         choices=["glb", "gltf", "obj", "ply", "stl", "json"],
         help="output format when the extension does not say it (json for stdout)",
     )
-    derive.add_argument("--seed", type=int, default=0, help="global random seed (default 0)")
+    derive.add_argument("--seed", type=_whole, default=0, help="global random seed (default 0)")
     derive.add_argument(
         "--set",
         action="append",
@@ -156,7 +157,7 @@ def build_parser() -> argparse.ArgumentParser:
         help="with --mode labels: also write OUT.legend.json (label -> colour)",
     )
     render.add_argument(
-        "--seed", type=int, default=None, help="global random seed for a .bgr (default 0)"
+        "--seed", type=_whole, default=None, help="global random seed for a .bgr (default 0)"
     )
     render.add_argument(
         "--set",
@@ -214,7 +215,7 @@ def build_parser() -> argparse.ArgumentParser:
         help="labels that stretch (default: every other label)",
     )
     infer.add_argument(
-        "--seed", type=int, default=0, help="seed for deriving a .bgr input (default 0)"
+        "--seed", type=_whole, default=0, help="seed for deriving a .bgr input (default 0)"
     )
     infer.add_argument("--lot", metavar="W,D|LOTS.geojson", help="lot for deriving a .bgr input")
     infer.add_argument(
@@ -246,21 +247,21 @@ def add_budget_options(command: argparse.ArgumentParser) -> None:
     """The limits a derivation runs under (interpreter/limits.py, docs/limits.md)."""
     command.add_argument(
         "--max-depth",
-        type=int,
+        type=_whole,
         default=DEFAULT_MAX_DEPTH,
         metavar="N",
         help=f"rule depth limit (default {DEFAULT_MAX_DEPTH})",
     )
     command.add_argument(
         "--max-shapes",
-        type=int,
+        type=_whole,
         default=DEFAULT_MAX_SHAPES,
         metavar="N",
         help=f"shape budget of the run (default {DEFAULT_MAX_SHAPES:,})",
     )
     command.add_argument(
         "--max-triangles",
-        type=int,
+        type=_whole,
         default=DEFAULT_MAX_TRIANGLES,
         metavar="N",
         help=f"triangle budget of the terminals (default {DEFAULT_MAX_TRIANGLES:,})",
@@ -395,17 +396,45 @@ def write_atomic(path: Path, text: str) -> None:
     write_text(path, text)
 
 
-def _parse_value(text: str):
-    """--set values: numbers, true/false, else strings (quotes optional)."""
+def _parse_value(text: str, item: str = ""):
+    """--set values: numbers, true/false, else strings (quotes optional).
+
+    A number is written as in the .bgr language (ASCII digits, optional sign, fraction and
+    exponent; interpreter/values.py): "1_000" and "١٠" stay strings, though Python's float()
+    reads both.  A number must be finite and in range, and "nan" or "inf" is refused rather
+    than passed on as a string that fails later, far from the option."""
+    from .interpreter.values import NUMBER_SYNTAX, is_number, number_of, number_problem
+
     if text in ("true", "false"):
         return text == "true"
-    try:
-        value = float(text)
-    except ValueError:
+    value = number_of(text)
+    if value is None and (NUMBER_SYNTAX.fullmatch(text) or _SPECIAL.fullmatch(text)):
+        value = float(text)  # 1e400, inf, nan: refused below
+    if value is None:
         return text[1:-1] if len(text) >= 2 and text[0] == text[-1] == '"' else text
-    return (
-        int(value) if value.is_integer() and "." not in text and "e" not in text.lower() else value
-    )
+    problem = number_problem(value) if is_number(value) else None
+    if problem:
+        raise BgrError(
+            Diagnostic(
+                "",
+                0,
+                0,
+                f"--set {item or text}: {text[:40]} is {problem}",
+                "write a number such as 12.5, or a string in quotes: --set 'NAME=\"text\"'",
+            )
+        )
+    return int(value) if isinstance(value, int) else value
+
+
+# what float() reads as infinite or not a number
+_SPECIAL = re.compile(r"[+-]?(inf|infinity|nan)", re.IGNORECASE)
+
+
+def _whole(text: str) -> int:
+    """An argparse type: a whole number in ASCII digits (int() also takes "1_000" and "١٠")."""
+    if not re.fullmatch(r"\s*[+-]?[0-9]{1,30}\s*", text):
+        raise argparse.ArgumentTypeError(f"{text[:40]!r} is not a whole number")
+    return int(text)
 
 
 def cmd_derive(args) -> int:
@@ -425,7 +454,7 @@ def cmd_derive(args) -> int:
         if not sep or not name.strip():
             print(f"bgr derive: --set {item}: write NAME=VALUE", file=sys.stderr)
             return EXIT_USAGE
-        attrs[name.strip()] = _parse_value(value.strip())
+        attrs[name.strip()] = _parse_value(value.strip(), item)
     limits = budgets(args)
     if isinstance(limits, str):
         print(f"bgr derive: {limits}", file=sys.stderr)
@@ -480,12 +509,15 @@ def cmd_infer(args) -> int:
 
 
 def _parse_size(text: str) -> tuple[int, int] | None:
-    width, sep, height = text.lower().partition("x")
-    if sep and width.strip().isdigit() and height.strip().isdigit():
-        size = int(width), int(height)
-        if 1 <= size[0] <= 16384 and 1 <= size[1] <= 16384:
-            return size
-    return None
+    """``WxH`` in ASCII digits (str.isdigit() also takes "²" and "١٠"), within the camera's
+    limits (render.camera.size_problem), or None."""
+    from .render.camera import size_problem
+
+    match = re.fullmatch(r"\s*([0-9]{1,6})\s*[xX]\s*([0-9]{1,6})\s*", text)
+    if match is None:
+        return None
+    size = int(match[1]), int(match[2])
+    return None if size_problem(*size) else size
 
 
 def cmd_render(args) -> int:
@@ -511,7 +543,8 @@ def cmd_render(args) -> int:
         size = _parse_size(args.size)
         if size is None:
             return usage(
-                f"--size {args.size}: write WIDTHxHEIGHT, e.g. 1024x768 (1 to 16384 pixels each)"
+                f"--size {args.size}: write WIDTHxHEIGHT, e.g. 1024x768 (1 to 8192 pixels each, "
+                "at most 4096x4096 pixels in all)"
             )
     if args.view not in VIEWS and not args.view.lower().endswith(".json"):
         return usage(f"--view {args.view}: give {', '.join(VIEWS)} or a camera file CAMERA.json")
@@ -529,7 +562,7 @@ def cmd_render(args) -> int:
         name, sep, value = item.partition("=")
         if not sep or not name.strip():
             return usage(f"--set {item}: write NAME=VALUE")
-        attrs[name.strip()] = _parse_value(value.strip())
+        attrs[name.strip()] = _parse_value(value.strip(), item)
     limits = budgets(args) if is_grammar else {}
     if isinstance(limits, str):
         return usage(limits)

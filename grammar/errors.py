@@ -28,16 +28,30 @@ class Diagnostic:
         head = f"{self.severity}: {self.message}"
         out = [f"{where}: {head}" if where else head]
         if self.source_line is not None and self.line:
-            text = self.source_line.rstrip("\r\n")
+            text, column = _excerpt(self.source_line.rstrip("\r\n"), self.column)
             gutter = f"{self.line:>5} | "
             out.append(gutter + text)
             # keep tabs so that the caret lines up under tab-indented code
-            lead = "".join(c if c == "\t" else " " for c in text[: max(self.column - 1, 0)])
-            width = max(1, min(self.length, max(len(text) - self.column + 1, 1)))
+            lead = "".join(c if c == "\t" else " " for c in text[: max(column - 1, 0)])
+            width = max(1, min(self.length, max(len(text) - column + 1, 1)))
             out.append(" " * (len(gutter) - 2) + "| " + lead + "^" + "~" * (width - 1))
         if self.hint:
             out.append(f"hint: {self.hint}")
         return "\n".join(out)
+
+
+_SHOWN = 160  # characters of a source line a message shows: a 10 MB line is cut around the caret
+
+
+def _excerpt(text: str, column: int) -> tuple[str, int]:
+    """A long line cut to about _SHOWN characters around ``column`` (marked with "..."), and the
+    column in the cut text."""
+    if len(text) <= _SHOWN:
+        return text, column
+    start = max(0, column - 1 - _SHOWN // 2)
+    end = start + _SHOWN
+    head = "..." if start else ""
+    return head + text[start:end] + ("..." if end < len(text) else ""), column - start + len(head)
 
 
 class BgrError(Exception):
@@ -114,10 +128,16 @@ def suggest(name: str, known: Iterable[str]) -> str | None:
     return f"did you mean '{close[0]}'?" if close else None
 
 
+def normalise_newlines(source: str) -> str:
+    """CRLF and a lone CR (old Mac files) made LF, as the parser reads text: so that every
+    reader of a file (check, derive, fmt, messages) agrees where its lines end."""
+    return source.replace("\r\n", "\n").replace("\r", "\n") if "\r" in source else source
+
+
 def source_lines(source: str) -> list[str]:
-    """Lines as the lexer counts them: only "\n" ends a line (str.splitlines also breaks at
-    "\r", "\f", "\u2028" ... which would put messages and comments on the wrong line)."""
-    return [line.removesuffix("\r") for line in source.split("\n")]
+    """Lines as the lexer counts them: "\n", "\r\n" and "\r" end a line (str.splitlines also
+    breaks at "\f", "\u2028" ... which would put messages and comments on the wrong line)."""
+    return normalise_newlines(source).split("\n")
 
 
 def source_line(source: str, line: int) -> str | None:
@@ -142,4 +162,10 @@ def read_json(path, what: str, hint: str | None = None):
     except json.JSONDecodeError as exc:
         raise BgrError(
             Diagnostic(shown, exc.lineno, exc.colno, f"not valid JSON: {exc.msg}")
+        ) from None
+    except ValueError as exc:  # an integer of more digits than Python converts (4,300)
+        raise BgrError(Diagnostic(shown, 0, 0, f"not usable JSON: {exc}")) from None
+    except RecursionError:
+        raise BgrError(
+            Diagnostic(shown, 0, 0, "not usable JSON: it nests arrays or objects too deeply")
         ) from None

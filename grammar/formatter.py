@@ -67,7 +67,11 @@ def format_string(value: str) -> str:
     if "\x00" in value:
         raise ValueError("a .bgr string cannot hold a NUL character")
     escaped = (
-        value.replace("\\", "\\\\").replace('"', '\\"').replace("\n", "\\n").replace("\t", "\\t")
+        value.replace("\\", "\\\\")
+        .replace('"', '\\"')
+        .replace("\n", "\\n")
+        .replace("\r", "\\r")
+        .replace("\t", "\\t")
     )
     return f'"{escaped}"'
 
@@ -468,7 +472,12 @@ def format_module(module: n.Module, width: int = WIDTH) -> str:
 
 
 def format_source(text: str, path: str = "<text>") -> str:
-    """Canonical text of .bgr source; raises BgrSyntaxError on text that does not parse."""
+    """Canonical text of .bgr source; raises BgrSyntaxError on text that does not parse, and
+    TypeError when ``text`` is not a ``str`` (a programmer's error)."""
+    if not isinstance(text, str):
+        raise TypeError(
+            f"bgr.format_source takes the text of a grammar (str), not {type(text).__name__}"
+        )
     from .parser import parse
 
     return format_module(parse(text, path))

@@ -18,7 +18,14 @@ from lark import Lark, Token, Transformer
 from lark.exceptions import UnexpectedCharacters, UnexpectedEOF, UnexpectedInput
 
 from . import nodes as n
-from .errors import BgrSyntaxError, Diagnostic, source_line, source_lines, suggest
+from .errors import (
+    BgrSyntaxError,
+    Diagnostic,
+    normalise_newlines,
+    source_line,
+    source_lines,
+    suggest,
+)
 from .limits import nesting_problem
 from .registry import KEYWORDS, OPERATIONS
 
@@ -109,7 +116,8 @@ class _Problem(Exception):
 def _unescape(tok: Token) -> str:
     body = tok[1:-1]
     out, i = [], 0
-    escapes = {'"': '"', "\\": "\\", "n": "\n", "t": "\t"}
+    # \r too: a raw CR ends a line (normalise_newlines), so a string holds one only escaped
+    escapes = {'"': '"', "\\": "\\", "n": "\n", "r": "\r", "t": "\t"}
     while i < len(body):
         c = body[i]
         if c == "\\":
@@ -120,7 +128,7 @@ def _unescape(tok: Token) -> str:
                 raise _Problem(
                     pos,
                     f"unknown escape '\\{nxt}' in a string",
-                    'strings know \\" \\\\ \\n and \\t; write \\\\ for a backslash',
+                    'strings know \\" \\\\ \\n \\r and \\t; write \\\\ for a backslash',
                     2,
                 )
             out.append(escapes[nxt])
@@ -321,6 +329,13 @@ class _TreeBuilder(Transformer):
         return n.Number(-value if c[0] == "-" else value, pos=_span(c))
 
     def string(self, c):
+        if len(c[0]) > MAX_STRING + 2:
+            raise _Problem(
+                _tok_pos(c[0]),
+                f"a string of {len(c[0]) - 2:,} characters is too long (at most {MAX_STRING:,})",
+                "keep long text out of the grammar",
+                length=1,
+            )
         return n.String(_unescape(c[0]), pos=_tok_pos(c[0]))
 
     def true(self, c):
@@ -427,6 +442,11 @@ def _order(stream: list) -> n.Expr:
     return operands[0]
 
 
+# a string literal's length: labels, colours and materials are short; a cap keeps a runaway (an
+# unclosed quote in generated text, a pasted file) from costing memory in every later copy
+MAX_STRING = 65_536
+
+
 def _number(tok: Token) -> float:
     value = float(tok)
     if math.isinf(value):
@@ -481,7 +501,14 @@ def _lark() -> Lark:
 
 
 def parse(text: str, path: str = "<text>") -> n.Module:
-    """Parse .bgr source text into a :class:`nodes.Module`; raise :class:`BgrSyntaxError`."""
+    """Parse .bgr source text into a :class:`nodes.Module`; raise :class:`BgrSyntaxError`.
+
+    Text that is not a ``str`` is a TypeError (a programmer's error, not a user's).  A line ends
+    at LF, CRLF or a lone CR; the module's ``source`` has them all as LF.
+    """
+    if not isinstance(text, str):
+        raise TypeError(f"bgr.parse takes the text of a grammar (str), not {type(text).__name__}")
+    text = normalise_newlines(text)
     if "\x00" in text:
         line = text.count("\n", 0, text.index("\x00")) + 1
         col = text.index("\x00") - (text.rfind("\n", 0, text.index("\x00")) + 1) + 1

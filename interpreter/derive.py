@@ -3,8 +3,9 @@
 from __future__ import annotations
 
 import os
-from collections.abc import Iterable
+from collections.abc import Iterable, Mapping
 from dataclasses import dataclass, field, replace
+from numbers import Integral, Real
 from pathlib import Path
 
 from bgr.grammar.checker import Grammar
@@ -21,6 +22,7 @@ from .limits import (
 from .lots import DEFAULT_LOT, Lot, attr_overrides, parse_lot_option, rectangle
 from .randomness import child_hash, name_hash, root_hash
 from .terminals import TerminalTable
+from .values import SEED_RANGE, number_problem
 
 
 @dataclass
@@ -82,14 +84,18 @@ def derive(
     starts).  Passing one of them raises a located :class:`bgr.BgrError`; see docs/limits.md.
 
     ``allow_paths`` is passed to :func:`bgr.load` when ``grammar`` is not loaded yet.
+
+    Every argument is checked before anything is derived (docs/cli.md, "Values from outside"):
+    a seed outside -2**63 .. 2**64 - 1, limits under 1, attrs that are not finite numbers of at
+    most 1e9, booleans or strings, or a lot of any other form is a :class:`bgr.BgrError`.
     """
     if not isinstance(grammar, Grammar):
         grammar = load(grammar, allow_paths=allow_paths)
-    if isinstance(seed, bool) or not isinstance(seed, int):
-        raise BgrError(f"the seed must be a whole number, got {seed!r}")
+    _check_seed(seed)
+    _check_limits(max_depth=max_depth, max_shapes=max_shapes, max_triangles=max_triangles)
+    attrs = _checked_attrs(attrs)
     warnings = Warnings(strict)
     lots = _lots(lot, warnings)
-    attrs = dict(attrs or {})
     values = Engine(grammar, seed, attrs, max_depth, max_shapes).attrs  # the run's attrs
     if max_memory is None:
         max_memory = default_max_memory()
@@ -148,20 +154,80 @@ def _naming(error: BgrError, lot_name: str) -> BgrError:
     return type(error)(named)
 
 
-def _lots(lot, warnings: Warnings) -> list[Lot]:
+def _shown(value: object) -> str:
+    """``repr`` for a message, cut short (an int of 5,000 digits has no repr at all)."""
+    try:
+        text = repr(value)
+    except ValueError:
+        return f"a {type(value).__name__} too large to show"
+    return text if len(text) <= 60 else text[:57] + "..."
+
+
+def _check_seed(seed: object) -> None:
+    low, high = SEED_RANGE
+    if isinstance(seed, bool) or not isinstance(seed, int) or not low <= seed <= high:
+        raise BgrError(
+            f"the seed must be a whole number from -2**63 to 2**64 - 1, got {_shown(seed)}"
+        )
+
+
+def _check_limits(**limits: object) -> None:
+    for name, value in limits.items():
+        if isinstance(value, bool) or not isinstance(value, int) or value < 1:
+            raise BgrError(f"{name} must be a positive whole number, got {_shown(value)}")
+
+
+def _checked_attrs(attrs: object) -> dict:
+    """A copy of ``attrs=``: names are strings; values numbers (finite, |v| <= MAX_NUMBER),
+    booleans or strings, so that a bad value is refused here, naming the attr, rather than
+    failing deep in a derivation (or as an OverflowError)."""
+    if attrs is None:
+        return {}
+    if not isinstance(attrs, Mapping):
+        raise BgrError(f"attrs must be a dict of attr names to values, got {_shown(attrs)}")
+    out = {}
+    for name, value in attrs.items():
+        if not isinstance(name, str):
+            raise BgrError(f"attr names must be strings, got {_shown(name)}")
+        if isinstance(value, Real) and not isinstance(value, bool):
+            problem = number_problem(value)
+            if problem:
+                raise BgrError(f"attr '{name}': {_shown(value)} is {problem}")
+            value = int(value) if isinstance(value, Integral) else float(value)
+        elif not isinstance(value, (bool, str)):
+            raise BgrError(
+                f"attr '{name}': {_shown(value)} is not a number, true/false or a string"
+            )
+        out[name] = value
+    return out
+
+
+def _lots(lot: object, warnings: Warnings) -> list[Lot]:
+    """The lots ``derive(lot=)`` names: see its docstring; anything else is a BgrError."""
     if lot is None:
         return [rectangle(*DEFAULT_LOT)]
+    if isinstance(lot, (str, os.PathLike)):
+        return parse_lot_option(os.fspath(lot), warnings)
+    if isinstance(lot, Lot):
+        return [lot]
     if (
         isinstance(lot, (tuple, list))
         and len(lot) == 2
-        and all(isinstance(v, (int, float)) for v in lot)
+        and all(isinstance(v, Real) and not isinstance(v, bool) for v in lot)
     ):
-        return [rectangle(float(lot[0]), float(lot[1]))]
-    if isinstance(lot, (str, os.PathLike)):
-        return parse_lot_option(str(lot), warnings)
-    if isinstance(lot, Lot):
-        return [lot]
-    return list(lot)
+        return [rectangle(*lot)]
+    try:
+        lots = list(lot)  # any iterable of lots
+    except TypeError:
+        lots = None
+    if lots is not None and all(isinstance(v, Lot) for v in lots):
+        if not lots:
+            raise BgrError("lot is an empty list: there is no lot to derive on")
+        return lots
+    raise BgrError(
+        f'lot must be (width, depth), a "W,D" string, a GeoJSON path or a list of lots, '
+        f"got {_shown(lot)}"
+    )
 
 
 __all__ = ["derive", "Result", "child_hash", "name_hash", "root_hash"]

@@ -351,7 +351,8 @@ class Application:
                     chosen = chosen or choice
                     continue
                 p = self.value(choice.prob)
-                if isinstance(p, bool) or not isinstance(p, (int, float)) or p < 0:
+                # "not p >= 0" also refuses nan, which compares false with everything
+                if isinstance(p, bool) or not isinstance(p, (int, float)) or not p >= 0:
                     raise runtime_error(
                         self.module,
                         choice.pos,

@@ -309,9 +309,15 @@ class Compiler:
         if name == "randint":
 
             def randint(ctx):
-                lo, hi = (math.ceil(_num(module, pos, a(ctx))) for a in args)
+                # the whole numbers n with a <= n <= b: bounds need not be whole (2.5 -> 3)
+                a, b = (_num(module, pos, a(ctx)) for a in args)
+                if not (math.isfinite(a) and math.isfinite(b)):
+                    raise runtime_error(module, pos, f"randint({a!r}, {b!r}) needs finite bounds")
+                lo, hi = math.ceil(a), math.floor(b)
                 if hi < lo:
-                    raise runtime_error(module, pos, f"randint({lo}, {hi}): the range is empty")
+                    raise runtime_error(
+                        module, pos, f"randint({a:g}, {b:g}): no whole number lies between them"
+                    )
                 return lo + min(int(ctx.stream.uniform() * (hi - lo + 1)), hi - lo)
 
             return randint

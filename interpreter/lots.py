@@ -13,7 +13,6 @@ feature among thousands does not stop a run.
 from __future__ import annotations
 
 import math
-import re
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -27,6 +26,7 @@ from bgr.grammar.errors import BgrError, Diagnostic, Warnings, read_json
 from .geometry.earclip import signed_area as ring_area
 from .geometry.polygons import RECT, is_unit_square, normalise, signed_area
 from .shapes import IDENTITY, Flat, Shape
+from .values import MAX_COORDINATE, is_number, number_of, number_problem
 
 DEFAULT_LOT = (20.0, 20.0)
 CLEAN_TOL = 1e-3  # metres: a corner this close to the previous one or to a straight line goes
@@ -50,8 +50,26 @@ class FootprintError(ValueError):
 
 
 def rectangle(width: float, depth: float) -> Lot:
-    if not (width > 0 and depth > 0 and math.isfinite(width) and math.isfinite(depth)):
-        raise BgrError(f"--lot {width:g},{depth:g}: a lot needs a positive width and depth")
+    """A W x D lot; each side must be a number over 0 and at most MAX_COORDINATE metres."""
+    sides = []
+    for side in (width, depth):
+        try:
+            sides.append(float(side))
+        except OverflowError:  # an int of more than about 309 digits
+            sides.append(math.inf)
+    width, depth = sides
+    if not all(0 < side <= MAX_COORDINATE for side in sides):  # also refuses nan
+        limit = f"{MAX_COORDINATE:.0e}".replace("e+0", "e")
+        raise BgrError(
+            Diagnostic(
+                "",
+                0,
+                0,
+                f"--lot {width:g},{depth:g}: a lot needs a width and depth over 0 and at most "
+                f"{limit} metres",
+                "write the lot as WIDTH,DEPTH in metres, e.g. 20,30",
+            )
+        )
     return Lot(Shape((0.0, 0.0, 0.0), IDENTITY, (width, 0.0, depth), Flat(1, RECT)))
 
 
@@ -86,14 +104,13 @@ def footprint(
 def parse_lot_option(value: str, warnings: Warnings | None = None) -> list[Lot]:
     """``W,D`` or a GeoJSON file of footprints."""
     if "," in value and not value.lower().endswith((".json", ".geojson")):
-        try:
-            width, depth = (float(v) for v in value.split(","))
-        except ValueError:
+        sides = [number_of(v) for v in value.split(",")]  # ASCII numbers only, as in .bgr
+        if len(sides) != 2 or sides[0] is None or sides[1] is None:  # "nan", "1_0", "1e400"
             raise BgrError(
-                f"--lot {value}: write the lot as WIDTH,DEPTH in metres (e.g. 20,30) "
-                "or give a GeoJSON file"
-            ) from None
-        return [rectangle(width, depth)]
+                f"--lot {value[:60]}: write the lot as WIDTH,DEPTH, two numbers in metres "
+                "(e.g. 20,30), or give a GeoJSON file"
+            )
+        return [rectangle(sides[0], sides[1])]
     return read_geojson(Path(value), warnings)
 
 
@@ -121,7 +138,10 @@ def read_geojson(path: Path, warnings: Warnings | None = None) -> list[Lot]:
             Diagnostic(shown, 0, 0, "a lot file must be a GeoJSON FeatureCollection or Feature")
         )
 
+    skipped: list[str] = []  # why, for the error when no feature is usable
+
     def skip(name: str, why: str) -> None:
+        skipped.append(f"{name} skipped: {why}")
         warnings.warn(
             Diagnostic(
                 shown,
@@ -169,6 +189,9 @@ def read_geojson(path: Path, warnings: Warnings | None = None) -> list[Lot]:
         lots.append(lot)
     if not lots:
         what = "no usable footprint" if polygons else "no Polygon features"
+        if skipped:
+            more = f" (and {len(skipped) - 1} more)" if len(skipped) > 1 else ""
+            what += f": {skipped[0]}{more}"
         raise BgrError(Diagnostic(shown, 0, 0, f"the lot file has {what}"))
     return lots
 
@@ -182,7 +205,10 @@ def feature_name(index: int, feature: dict) -> str:
     ident = feature.get("id")
     if ident is None and isinstance(feature.get("properties"), dict):
         ident = feature["properties"].get("id")
-    return f"feature {index} (id {ident})" if ident is not None else f"feature {index} (no id)"
+    if ident is None:
+        return f"feature {index} (no id)"
+    shown = ident if isinstance(ident, str) else _shown(ident)
+    return f"feature {index} (id {shown[:40]}{'...' if len(shown) > 40 else ''})"
 
 
 def _outer_rings(feature: dict) -> list:
@@ -204,21 +230,35 @@ def _outer_rings(feature: dict) -> list:
             except FootprintError as e:
                 out.append(e)
         return out
-    raise FootprintError(f"a {kind} is not a footprint" if kind else "its geometry has no type")
+    if not kind:
+        raise FootprintError("its geometry has no type")
+    shown = kind[:40] if isinstance(kind, str) else _shown(kind)[:40]
+    raise FootprintError(f"a {shown} is not a footprint")
 
 
 def _ring(polygon) -> np.ndarray:
     """The outer ring of GeoJSON Polygon coordinates (holes are left out: see clean_ring)."""
     if not isinstance(polygon, list) or not polygon or not isinstance(polygon[0], list):
         raise FootprintError("malformed Polygon coordinates")
+    corners = polygon[0]
+    if len(corners) < 3:
+        raise FootprintError("its outline has fewer than three corners")
+    if not all(
+        isinstance(c, list) and len(c) >= 2 and is_number(c[0]) and is_number(c[1]) for c in corners
+    ):
+        raise FootprintError("its coordinates are not [x, y] numbers")
     try:
-        ring = np.array([(float(c[0]), float(c[1])) for c in polygon[0]], dtype=np.float64).reshape(
-            -1, 2
-        )
-    except (TypeError, ValueError, IndexError, KeyError):
-        raise FootprintError("its coordinates are not [x, y] numbers") from None
+        ring = np.array([(float(c[0]), float(c[1])) for c in corners], dtype=np.float64)
+    except OverflowError:  # an int of more than about 309 digits
+        raise FootprintError("its coordinates are not all finite") from None
     if not np.isfinite(ring).all():
         raise FootprintError("its coordinates are not all finite")
+    if np.abs(ring).max() > MAX_COORDINATE:
+        raise FootprintError(
+            f"its coordinates are out of range (at most {MAX_COORDINATE:.0e} in size)".replace(
+                "e+0", "e"
+            )
+        )
     return ring
 
 
@@ -364,25 +404,6 @@ def _repair(pts: np.ndarray, poly: Polygon) -> tuple[np.ndarray, str | None]:
 # properties
 
 
-_NUMBER = re.compile(r"[+-]?(?:[0-9]+(?:\.[0-9]*)?|\.[0-9]+)(?:[eE][+-]?[0-9]+)?")
-_INTEGER = re.compile(r"[+-]?[0-9]+")
-
-
-def number_of(text: str) -> int | float | None:
-    """The number a property string spells — ``"6"`` is 6, ``"12.5"`` is 12.5, surrounding
-    spaces allowed — or None: no digit separators (``"1_000"``), no non-ASCII digits, no
-    ``inf`` or ``nan`` (Python's ``float`` takes all three; data should not)."""
-    text = text.strip()
-    if not _NUMBER.fullmatch(text):
-        return None
-    value = int(text) if _INTEGER.fullmatch(text) else float(text)
-    return value if math.isfinite(value) else None
-
-
-def _is_number(value) -> bool:
-    return isinstance(value, (int, float)) and not isinstance(value, bool)
-
-
 def attr_overrides(lot: Lot, attrs: dict, warnings: Warnings) -> dict:
     """The attr values a lot's properties give: a property overrides the attr of its name when
     its value fits the attr's type (the run's value of the attr): a number attr takes a finite
@@ -394,29 +415,31 @@ def attr_overrides(lot: Lot, attrs: dict, warnings: Warnings) -> dict:
         if key not in attrs or value is None:
             continue
         current = attrs[key]
-        if _is_number(current):
+        if is_number(current):
             fitted = number_of(value) if isinstance(value, str) else value
-            ok = _is_number(fitted) and math.isfinite(fitted)
-            need = "a number"
+            ok, need = is_number(fitted), "a number"
         elif isinstance(current, bool):
             fitted, ok, need = value, isinstance(value, bool), "true or false"
         elif isinstance(current, str):
             fitted, ok, need = value, isinstance(value, str), "a string"
         else:
             fitted, ok, need = value, isinstance(value, (int, float, str, bool)), "a value"
-        if ok:
+        # a number must be finite and in range, whichever attr it is for
+        problem = number_problem(fitted) if ok and is_number(fitted) else None
+        if ok and problem is None:
             out[key] = fitted
-        else:
-            warnings.warn(
-                Diagnostic(
-                    lot.source,
-                    0,
-                    0,
-                    f"{lot.name}: property '{key}' is {_shown(value)}, not {need}; "
-                    f"the attr '{key}' keeps its value",
-                    "without --strict the property is ignored with a warning",
-                )
+            continue
+        why = problem or f"not {need}"
+        warnings.warn(
+            Diagnostic(
+                lot.source,
+                0,
+                0,
+                f"{lot.name}: property '{key}' is {_shown(value)}, {why}; "
+                f"the attr '{key}' keeps its value",
+                "without --strict the property is ignored with a warning",
             )
+        )
     return out
 
 
@@ -425,5 +448,8 @@ def _shown(value) -> str:
 
     try:
         return json.dumps(value, ensure_ascii=False, allow_nan=True)[:60]
-    except (TypeError, ValueError):
-        return repr(value)[:60]
+    except (TypeError, ValueError):  # not JSON; or an int of more digits than str() converts
+        try:
+            return repr(value)[:60]
+        except ValueError:
+            return "a number of thousands of digits"

@@ -47,6 +47,30 @@ PRESETS = {  # view name -> (yaw, pitch, roll, fov) in degrees
     "top": (0.0, 90.0, 0.0, 35.0),
 }
 MARGIN = 0.05  # presets leave this fraction of the image free on each side
+# image size: each side at most MAX_SIDE pixels, and at most MAX_PIXELS in all (4096 x 4096):
+# the numpy rasteriser keeps about 50 bytes a pixel, so the largest image needs under 1 GB
+MAX_SIDE = 8192
+MAX_PIXELS = 4096 * 4096
+MAX_NUMBER = 1e8  # |v| of a camera file's numbers: positions in metres, angles in degrees
+
+
+def size_problem(width: int, height: int) -> str | None:
+    """Why an image size cannot be rendered, or None."""
+    if not (1 <= width <= MAX_SIDE and 1 <= height <= MAX_SIDE):
+        return f"each side must be 1 to {MAX_SIDE} pixels"
+    if width * height > MAX_PIXELS:
+        return f"at most {MAX_PIXELS:,} pixels in all (e.g. 4096x4096)"
+    return None
+
+
+def _finite(value: object) -> bool:
+    """A JSON number usable as a camera value: finite and |v| <= MAX_NUMBER (not a bool)."""
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        return False
+    try:
+        return math.isfinite(value) and abs(value) <= MAX_NUMBER
+    except OverflowError:  # an int of more than about 309 digits
+        return False
 
 
 def rot_x(deg: float) -> np.ndarray:
@@ -92,8 +116,11 @@ class Camera:
         self.size = (int(self.size[0]), int(self.size[1]))
         if not 0.0 < float(self.fov) < 180.0:
             raise BgrError(f"the field of view must be between 0 and 180 degrees, got {self.fov}")
-        if self.size[0] < 1 or self.size[1] < 1:
-            raise BgrError(f"the image size must be positive, got {self.size[0]}x{self.size[1]}")
+        problem = size_problem(*self.size)
+        if problem:
+            raise BgrError(f"the image size {self.size[0]}x{self.size[1]} is too large: {problem}")
+        if not (np.isfinite(self.position).all() and np.isfinite(self.principal_point).all()):
+            raise BgrError("the camera position and principal point must be finite numbers")
         if (
             not np.allclose(self.rotation @ self.rotation.T, np.eye(3), atol=1e-6)
             or np.linalg.det(self.rotation) < 0
@@ -298,6 +325,12 @@ KEYS = (
 )
 
 
+def _json(value: object) -> str:
+    """A value as a message shows it: JSON, cut short."""
+    text = json.dumps(value)
+    return text if len(text) <= 60 else text[:57] + "..."
+
+
 def _from_dict(cls, data: Any, shown: str, size) -> Camera:
     def bad(message: str, hint: str | None = None) -> BgrError:
         return BgrError(Diagnostic(shown, 0, 0, message, hint))
@@ -318,12 +351,11 @@ def _from_dict(cls, data: Any, shown: str, size) -> Camera:
         value = data.get(key, default)
         if value is None:
             raise bad(f"the camera needs '{key}'")
-        if (
-            isinstance(value, bool)
-            or not isinstance(value, (int, float))
-            or not math.isfinite(value)
-        ):
-            raise bad(f"camera key '{key}' must be a number, got {json.dumps(value)}")
+        if not _finite(value):
+            raise bad(
+                f"camera key '{key}' must be a number (at most {MAX_NUMBER:,.0f} in size), "
+                f"got {_json(value)}"
+            )
         return float(value)
 
     def vector(key: str, n: int, default=None) -> np.ndarray:
@@ -339,20 +371,16 @@ def _from_dict(cls, data: Any, shown: str, size) -> Camera:
                 else None
             )
         )
-        if (
-            not isinstance(flat, list)
-            or len(flat) != n
-            or not all(
-                isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v)
-                for v in flat
-            )
-        ):
+        if not isinstance(flat, list) or len(flat) != n or not all(_finite(v) for v in flat):
             shape = (
                 "a 3x3 matrix (a list of three rows of three numbers)"
                 if key == "rotation"
                 else f"a list of {n} numbers"
             )
-            raise bad(f"camera key '{key}' must be {shape}, got {json.dumps(value)}")
+            raise bad(
+                f"camera key '{key}' must be {shape} (each at most {MAX_NUMBER:,.0f} in size), "
+                f"got {_json(value)}"
+            )
         return np.array(flat, dtype=np.float64)
 
     fov = number("fov", 40.0)
@@ -364,10 +392,12 @@ def _from_dict(cls, data: Any, shown: str, size) -> Camera:
         size = (1024, 768)
         if "size" in data:
             sz = vector("size", 2)
-            if not all(v >= 1 and float(v).is_integer() for v in sz):
+            whole = all(float(v).is_integer() for v in sz)
+            if not whole or size_problem(int(sz[0]), int(sz[1])):
                 raise bad(
-                    "camera key 'size' must be two positive whole numbers, got "
-                    f"{json.dumps(data['size'])}"
+                    f"camera key 'size' must be two positive whole numbers, 1 to {MAX_SIDE} "
+                    f"each and at most {MAX_PIXELS:,} pixels in all; got {_json(data['size'])}",
+                    "--size WxH overrides it",
                 )
             size = (int(sz[0]), int(sz[1]))
     angles = [k for k in ("yaw", "pitch", "roll") if k in data]

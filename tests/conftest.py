@@ -24,8 +24,8 @@ def pytest_addoption(parser: pytest.Parser) -> None:
         "--fuzz-cases",
         type=int,
         default=None,
-        help="examples per fuzz test in tests/test_fuzz.py (nightly: 100000); default: each "
-        "test's own small count",
+        help="examples per fuzz test in tests/test_fuzz.py and tests/test_fuzz_geojson.py "
+        "(nightly: 100000); default: each test's own small count",
     )
 
 

@@ -257,7 +257,7 @@ def test_a_non_finite_json_number_is_refused(tmp_path):
     )
     result = bgr.derive(BOX, lot=str(geo))
     assert heights(result) == [10.0]
-    assert "property 'height' is NaN, not a number" in result.warnings[0].message
+    assert "property 'height' is NaN, not a finite number" in result.warnings[0].message
 
 
 # ---------------------------------------------------------------------------------------------
@@ -427,3 +427,109 @@ def test_render_prints_the_warnings_of_a_grammar(tmp_path):
     model = tmp_path / "x.glb"
     assert bgr_cli("derive", src, "-o", model).returncode == 0
     assert bgr_cli("render", model, "-o", out, "--strict").returncode == 2
+
+
+# ---------------------------------------------------------------------------------------------
+# hostile files: each bad value is a located warning (the feature or property skipped) or one
+# BgrError for the file, never an internal error (issue 10)
+
+GOOD = feature([square(0, 0)], {"id": 1})
+
+
+@pytest.mark.parametrize(
+    "bad, why",
+    [
+        ([1, 2], None),  # a feature that is a list: no geometry, counted as no Polygon
+        (feature([[]]), "fewer than three corners"),  # an empty ring
+        (feature([]), "malformed Polygon coordinates"),
+        (feature([[[0, 0], [1e300, 0], [1e300, 10], [0, 10]]]), "out of range (at most 1e8"),
+        (feature([[[0, 0], [10**400, 0], [5, 5]]]), "not all finite"),
+        (feature([[[0, 0], [True, 0], [5, 5]]]), "not [x, y] numbers"),
+        (feature([[[0, 0], [None, 0], [5, 5]]]), "not [x, y] numbers"),
+        (feature([[[0, 0], "ab", [5, 5]]]), "not [x, y] numbers"),
+        (feature([[[0, 0], [1], [5, 5]]]), "not [x, y] numbers"),
+        (feature("abc"), "malformed Polygon coordinates"),
+        (feature([[[[0, 0]], [[1, 1]], [[2, 0]]]]), "not [x, y] numbers"),
+        (feature([[None]], kind="MultiPolygon"), "malformed Polygon coordinates"),
+        (feature(square(0, 0), kind="MultiPolygon"), "malformed Polygon coordinates"),
+        (feature(None, kind="MultiPolygon"), "it has no geometry"),
+        ({"type": "Feature", "geometry": [1]}, None),
+        ({"type": "Feature", "geometry": {"type": ["Polygon"], "coordinates": []}}, None),
+    ],
+)
+def test_a_hostile_feature_is_skipped_or_refused_by_name(tmp_path, bad, why):
+    geo = write(tmp_path, GOOD, bad)
+    result = bgr.derive(BOX, lot=str(geo))
+    assert len(result.terminals) == 1
+    if why is None:  # not a polygon at all: ignored, as any other geometry
+        return
+    warning = result.warnings[0]  # a MultiPolygon warns once for each of its polygons
+    assert warning.message.startswith("feature 1 (no id)") and why in warning.message
+    alone = write(tmp_path, bad, name="alone.geojson")  # the only feature: the error says why
+    none = "has no (usable footprint|Polygon features): feature 0 .* skipped: "
+    with pytest.raises(bgr.BgrError, match=none):
+        bgr.derive(BOX, lot=str(alone))
+
+
+def test_a_repeated_first_corner_is_dropped(tmp_path):
+    ring = [[0, 0], [0, 0], [0, 0], [10, 0], [10, 10], [0, 10], [0, 0]]
+    result = bgr.derive(BOX, lot=str(write(tmp_path, feature([ring]))))
+    assert len(result.terminals) == 1 and not result.warnings
+
+
+@pytest.mark.parametrize(
+    "text, why",
+    [
+        ("1e400", "Infinity, not a finite number"),
+        ("NaN", "NaN, not a finite number"),
+        ("1e300", "1e+300, out of range (at most 1e9"),
+        ("-2e9", "-2000000000.0, out of range"),
+        ("1" + "0" * 400, "0, out of range (at most 1e9"),
+        ('"1e300"', '"1e300", out of range'),
+        ('"1e400"', '"1e400", not a number'),
+        ("[1]", "[1], not a number"),
+    ],
+)
+def test_a_property_out_of_range_keeps_the_attr(tmp_path, text, why):
+    geo = tmp_path / "p.geojson"
+    good = json.dumps(feature([square(0, 0)], {"height": "HEIGHT"}))
+    geo.write_text(good.replace('"HEIGHT"', text))
+    result = bgr.derive(BOX, lot=str(geo))
+    assert heights(result) == [10.0]
+    (warning,) = result.warnings
+    assert "property 'height' is " in warning.message and why in warning.message
+    with pytest.raises(bgr.BgrError, match="property 'height'"):
+        bgr.derive(BOX, lot=str(geo), strict=True)
+
+
+@pytest.mark.parametrize(
+    "text, message",
+    [
+        ("[" * 100_000 + "]" * 100_000, "nests arrays or objects too deeply"),
+        ('{"a": ' + "1" * 5000 + "}", "not usable JSON"),
+        ('{"type": "FeatureCollection"}', "a GeoJSON FeatureCollection or Feature"),
+        ('{"type": "FeatureCollection", "features": null}', "FeatureCollection or Feature"),
+        ('{"type": "FeatureCollection", "features": {}}', "FeatureCollection or Feature"),
+        ("null", "FeatureCollection or Feature"),
+        ("[1, 2]", "FeatureCollection or Feature"),
+        ('{"type": "FeatureCollection", "features": [[1], "x", null, 3]}', "no Polygon features"),
+        ('{"type": "Feature"', "not valid JSON"),
+    ],
+)
+def test_a_hostile_file_is_one_error(tmp_path, text, message):
+    geo = tmp_path / "bad.geojson"
+    geo.write_text(text)
+    with pytest.raises(bgr.BgrError, match=message) as caught:
+        bgr.derive(BOX, lot=str(geo))
+    assert caught.value.path == str(geo)
+
+
+def test_properties_that_are_no_object_are_no_properties(tmp_path):
+    geo = write(tmp_path, {"type": "Feature", "properties": [1], "geometry": GOOD["geometry"]})
+    assert heights(bgr.derive(BOX, lot=str(geo))) == [10.0]
+
+
+def test_a_long_id_is_cut_in_messages(tmp_path):
+    geo = write(tmp_path, feature([[]], ident="x" * 100_000), GOOD)
+    (warning,) = bgr.derive(BOX, lot=str(geo)).warnings
+    assert warning.message.startswith("feature 0 (id " + "x" * 40 + "...) skipped")

@@ -1183,8 +1183,13 @@ def test_bug3_fmt_idempotent_with_comment_in_last_alternative(text):
 # Bug 4: line numbers come from the lexer, which counts only '\n', but parser.py (own_line),
 # formatter.py (blank_before) and errors.source_line use str.splitlines(), which also breaks at
 # \r, \v, \f, \x1c-\x1e, \x85, \u2028 and \u2029: inside a string or a comment these shift lines.
+# Since issue 10 a lone \r ends a line everywhere (the parser normalises line ends), so a raw
+# \r inside a string ends the line the string is on: an unterminated string, on that line.
 def test_bug4_fmt_idempotent_with_carriage_returns_in_a_string():
-    assert_round_trip('attr a = "\r\r"\nattr b = 1\nattr c = 2\n')
+    assert_round_trip("attr a = 1 # c\rattr b = 1\r\nattr c = 2\n", ["# c"])
+    with pytest.raises(BgrError, match="unterminated string") as info:
+        format_source('attr a = "\r\r"\nattr b = 1\nattr c = 2\n')
+    assert info.value.diagnostics[0].line == 1
 
 
 def test_bug4_fmt_invents_no_blank_line():
@@ -1193,7 +1198,7 @@ def test_bug4_fmt_invents_no_blank_line():
 
 def test_bug4_error_shows_its_own_line():
     with pytest.raises(BgrError) as info:
-        bgr.load('attr a = "\r"\nattr b = ?\n')
+        bgr.load('attr a = "\v\f\u2028"\nattr b = ?\n')
     assert info.value.diagnostics[0].line == 2
     assert info.value.diagnostics[0].source_line == "attr b = ?"
 

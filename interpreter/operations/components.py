@@ -192,6 +192,10 @@ def _face_shape(shape, rings, nrm):
     return face
 
 
+def _shown(value) -> str:
+    return f'the string "{value}"' if isinstance(value, str) else repr(value)
+
+
 def _slant(nrm) -> str:
     """CGA's vertical, horizontal and aslant: the face's normal within 1 degree of the scope's
     horizontal plane, within 1 degree of its y axis, or neither."""
@@ -203,7 +207,14 @@ def _slant(nrm) -> str:
 
 def _matches(app, key, kind: str, index: int, slant: str) -> bool:
     if isinstance(key, n.Call):  # face(i)
-        return int(app.value(key.args[0])) == index
+        i = app.value(key.args[0])
+        # a whole number only: face(0.5) is no face (int() would make it face 0)
+        whole = isinstance(i, int) or (isinstance(i, float) and i.is_integer())
+        if isinstance(i, bool) or not whole:
+            raise runtime_error(
+                app.module, key.pos, f"face() needs a whole number, got {_shown(i)}"
+            )
+        return i == index
     name = key.name
     if name in ("all", kind, slant):
         return True
