@@ -45,6 +45,7 @@ from .shapes import Flat, Shape, Solid
 from .terminals import TerminalTable, UnitMesh
 
 SYMBOL_KINDS = {AXIS, AXES, COMP_KIND, ROOF_KIND, FOOTPRINT_KIND, EXTRUDE_KIND, GEOMETRY}
+_NUMBER = (float, int)  # bool is neither: True.__class__ is bool
 EMIT = object()  # marks a children-list entry that is a finished terminal, kept in order
 _NAME_HASHES: dict[str, int] = {}
 
@@ -437,7 +438,7 @@ class Application:
         ]
         for i, value in enumerate(out):
             number = value[1] if value.__class__ is tuple else value
-            if number.__class__ is float and not -MAX_COORDINATE <= number <= MAX_COORDINATE:
+            if number.__class__ in _NUMBER and not -MAX_COORDINATE <= number <= MAX_COORDINATE:
                 self.out_of_range(step, i, number)
         out.append(received)
         return out
