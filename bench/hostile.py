@@ -32,6 +32,12 @@ RUNAWAYS = {
     "3 M terminals of 2 triangles": ("Lot --> split(x) { 0.01: T }*", ["--lot", "29000,10"]),
     "house, height 1e9": (None, ["--set", "height=1e9"]),
     "scale by 1e308": ("Lot --> extrude(3) s('1e308, 0, 1)", []),
+    # the slowest per shape: every other piece is extruded and its top face taken, a mesh each
+    "explosion through extrude, comp": (
+        "Lot --> A\nA --> split(x) { ~1: extrude(1) comp(f) { top: B } | ~1: A }\n"
+        "B --> split(y) { ~1: A | ~1: A }",
+        [],
+    ),
 }
 
 

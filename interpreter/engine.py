@@ -57,6 +57,11 @@ def _name_hash(name: str) -> int:
     return found
 
 
+def _rule_of(module, member: str):
+    """The rule a successor applies; None for a terminal (which makes no new shape)."""
+    return None if member in module.terminals else module.rules[member]
+
+
 # operations after which the scope's size or place may have grown past MAX_COORDINATE
 _SCOPE_CHANGERS = frozenset(
     name for name, op in OPERATIONS.items() if op.family in ("transforms", "roofs", "inserts")
@@ -102,6 +107,9 @@ class Engine:
         # id(operation node) -> its signature (the grammar outlives us)
         self.signatures: dict[int, tuple] = {}
         self.uses_center: dict[int, bool] = {}  # id(step list) -> does it call center()?
+        # id(successor) -> (module, member, member's name hash, its rule or None if a terminal)
+        self.targets: dict[int, tuple] = {}
+        self.rule_locals: dict[int, frozenset] = {}  # id(rule) -> its parameter names
 
     def _prepare_values(self, grammar, overrides: dict) -> dict:
         unknown = [k for k in overrides if k not in grammar.attrs]
@@ -306,6 +314,19 @@ class Engine:
 class Application:
     """One rule applied to one shape: runs the body's steps and collects the children."""
 
+    # one is made per shape derived: slots make that, and every attribute read, cheaper
+    __slots__ = (
+        "engine",
+        "shape",
+        "module",
+        "rule",
+        "compiler",
+        "local",
+        "ctx",
+        "children",
+        "counter",
+    )
+
     def __init__(
         self,
         engine: Engine,
@@ -317,9 +338,12 @@ class Application:
     ) -> None:
         self.engine, self.shape, self.module, self.rule = engine, shape, module, rule
         self.compiler = engine.compilers[id(module)]
-        self.local = frozenset(rule.params)
+        local = engine.rule_locals.get(id(rule))
+        if local is None:
+            local = engine.rule_locals[id(rule)] = frozenset(rule.params)
+        self.local = local
         # split.index/total and comp.index/total of the piece this shape came from stay visible
-        self.ctx = Context(shape, args, Stream(shape.hash), engine.seed, indices[:2], indices[2:])
+        self.ctx = Context(shape, args, Stream(shape.hash), engine.seed, indices)
         self.children: list = []
         self.counter = 0
         if len(args) != len(rule.params):
@@ -476,18 +500,24 @@ class Application:
         return tuple(plan)
 
     def successor(self, shape: Shape, step: n.Successor, handover: bool = False) -> None:
+        engine = self.engine
         if step.name in self.local:  # a rule handed over in a parameter
             module, member = self.target(step)
+            found = (module, member, _name_hash(member), _rule_of(module, member))
         else:
-            module, member = self.module.lookup_module(step.name)
+            found = engine.targets.get(id(step))
+            if found is None:
+                module, member = self.module.lookup_module(step.name)
+                found = (module, member, _name_hash(member), _rule_of(module, member))
+                engine.targets[id(step)] = found
+        module, member, member_hash, rule = found
         args = self.bind(module, member, step) if step.args else {}
         child = shape if handover else shape.copy()
         index = self.counter
         self.counter += 1
         child.path = f"{shape.path}/{member}.{index}"
-        child.hash = child_hash(shape.hash, _name_hash(member), index)
+        child.hash = child_hash(shape.hash, member_hash, index)
         child.depth = shape.depth + 1
-        engine = self.engine
         engine.count_shape(self.module, step.pos)
         if child.depth > engine.max_depth:
             raise runtime_error(
@@ -496,11 +526,10 @@ class Application:
                 f"the derivation is deeper than {engine.max_depth} rules (at '{step.name}')",
                 "a rule calls itself without end? Raise the limit with --max-depth N",
             )
-        if member in module.terminals:
+        if rule is None:  # a terminal
             child.label = child.label or member
             self.children.append((EMIT, child, member, member, self.module, step.pos))
             return
-        rule = module.rules[member]
         ctx = self.ctx
         self.children.append(
             (
@@ -564,6 +593,13 @@ class Application:
     def piece(self, shape: Shape, body: n.Sequence, split=None, comp=None) -> None:
         """Run a block entry's steps on one piece (a split piece, a face, an inset)."""
         ctx = self.ctx
+        if comp is None:  # a split piece: only split.index and split.total change
+            saved_split = ctx.split_index, ctx.split_total
+            if split is not None:
+                ctx.split_index, ctx.split_total = split
+            self.sequence(shape, body.steps)
+            ctx.split_index, ctx.split_total = saved_split
+            return
         saved = (
             ctx.split_index,
             ctx.split_total,
@@ -574,8 +610,7 @@ class Application:
         )
         if split is not None:
             ctx.split_index, ctx.split_total = split
-        if comp is not None:
-            ctx.comp_index, ctx.comp_total, ctx.comp_left, ctx.comp_right = comp
+        ctx.comp_index, ctx.comp_total, ctx.comp_left, ctx.comp_right = comp
         self.sequence(shape, body.steps)
         (
             ctx.split_index,

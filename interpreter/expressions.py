@@ -56,11 +56,19 @@ class Context:
     )
 
     def __init__(
-        self, shape, args: dict, stream, seed: int, split=(0, 1), comp=(0, 1, 0.0, 0.0)
+        self, shape, args: dict, stream, seed: int, indices=(0, 1, 0, 1, 0.0, 0.0)
     ) -> None:
+        """``indices``: split.index, split.total, comp.index, comp.total and the comp face's
+        left and right neighbour angles of the piece the shape came from."""
         self.shape, self.args, self.stream, self.seed = shape, args, stream, seed
-        self.split_index, self.split_total = split
-        self.comp_index, self.comp_total, self.comp_left, self.comp_right = comp
+        (
+            self.split_index,
+            self.split_total,
+            self.comp_index,
+            self.comp_total,
+            self.comp_left,
+            self.comp_right,
+        ) = indices
 
 
 class RuleRef:

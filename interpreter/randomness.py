@@ -32,7 +32,11 @@ def root_hash(seed: int) -> int:
 
 
 def child_hash(parent: int, rule_hash: int, index: int) -> int:
-    return mix((parent ^ rule_hash) + (index + 1) * GOLDEN & MASK)
+    # mix() written out: this runs once per shape derived
+    z = (parent ^ rule_hash) + (index + 1) * GOLDEN & MASK
+    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9 & MASK
+    z = (z ^ (z >> 27)) * 0x94D049BB133111EB & MASK
+    return z ^ (z >> 31)
 
 
 class Stream:

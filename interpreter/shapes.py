@@ -40,6 +40,9 @@ class Solid:
     name: str  # what the terminal list's "geometry" says: cube, roof, an asset's name...
 
 
+_new_shape = object.__new__
+
+
 class Shape:
     """One shape of the derivation.  Copied, never shared, between parent and children."""
 
@@ -83,18 +86,18 @@ class Shape:
         self.frame = None  # (origin, axes) of the shape this one was cut from; None: the world
 
     def copy(self) -> Shape:
-        twin = Shape(
-            self.origin,
-            self.axes,
-            self.size,
-            self.geom,
-            self.color,
-            self.material,
-            self.label,
-            self.path,
-            self.hash,
-            self.depth,
-        )
+        # slot by slot, not through __init__: a derivation copies shapes millions of times
+        twin = _new_shape(Shape)
+        twin.origin = self.origin[:]
+        twin.axes = self.axes
+        twin.size = self.size[:]
+        twin.geom = self.geom
+        twin.color = self.color
+        twin.material = self.material
+        twin.label = self.label
+        twin.path = self.path
+        twin.hash = self.hash
+        twin.depth = self.depth
         twin.frame = self.frame
         return twin
 

@@ -95,7 +95,10 @@ def _clip(app, step, geom, axis: int, lo: float, hi: float):
 def split(app, shape, step, args) -> bool:
     axis = "xyz".index(args[0])
     length = shape.size[axis]
-    sizes = _sizes(app, step.block.entries)
+    entries = step.block.entries
+    sizes = app.engine.constant_sizes.get(id(entries))  # most splits: numbers in the grammar
+    if sizes is None:
+        sizes = _sizes(app, entries)
     key = (id(step.block), sizes, length)
     cache = app.engine.split_cache
     placed = cache.get(key)
