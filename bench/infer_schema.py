@@ -18,7 +18,7 @@ import statistics
 import time
 
 import bgr
-from bgr.interpreter.writers import write_json
+from bgr.formats import write_json
 from bgr.inverse.schema import infer
 
 GRAMMAR = """\

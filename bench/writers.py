@@ -22,9 +22,9 @@ from pathlib import Path
 
 import numpy as np
 
+from bgr.formats import write
+from bgr.formats.glb import write_glb
 from bgr.interpreter.terminals import TerminalTable, UnitMesh
-from bgr.interpreter.writers import write
-from bgr.interpreter.writers.glb import write_glb
 
 BOX_V = np.array([[x, y, z] for x in (0, 1) for y in (0, 1) for z in (0, 1)], dtype=float)
 BOX_F = np.array(

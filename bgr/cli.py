@@ -391,7 +391,7 @@ def cmd_fmt(args) -> int:
 
 def write_atomic(path: Path, text: str) -> None:
     """Write beside the target and rename over it, so a failure never leaves half a file."""
-    from .interpreter.writers.atomic import write_text
+    from .formats.atomic import write_text
 
     write_text(path, text)
 
@@ -438,8 +438,8 @@ def _whole(text: str) -> int:
 
 
 def cmd_derive(args) -> int:
+    from .formats import write
     from .interpreter.derive import derive
-    from .interpreter.writers import write
 
     if args.output in (None, "-") and args.format != "json":
         print(

@@ -42,13 +42,13 @@ class Result:
     @property
     def mesh(self):
         """One ``trimesh.Trimesh`` of every terminal, with face colours."""
-        from .writers import to_trimesh
+        from bgr.formats import to_trimesh
 
         return to_trimesh(self.terminals)
 
     def save(self, path: str | os.PathLike, fmt: str | None = None) -> None:
         """Write by extension (.glb .gltf .obj .ply .stl .json), atomically."""
-        from .writers import write
+        from bgr.formats import write
 
         write(self.terminals, Path(path), seed=self.seed, attrs=self.attrs, fmt=fmt)
 

@@ -196,7 +196,7 @@ def save_png(image: np.ndarray, path: str | os.PathLike) -> None:
     failure, and an existing file is replaced whole or not at all."""
     from PIL import Image
 
-    from ..interpreter.writers.atomic import atomic_files
+    from ..formats.atomic import atomic_files
 
     path = Path(path)
     _check_suffix(path, ".png")
@@ -210,7 +210,7 @@ def save_png(image: np.ndarray, path: str | os.PathLike) -> None:
 
 def save_legend(legend: dict, path: str | os.PathLike) -> None:
     """Write a labels legend as JSON, atomically."""
-    from ..interpreter.writers.atomic import atomic_files
+    from ..formats.atomic import atomic_files
 
     path = Path(path)
     with atomic_files([path]) as (f,):

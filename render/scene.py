@@ -72,7 +72,7 @@ def _labels_index(names) -> tuple[np.ndarray, list[str]]:
 
 def from_result(result: Any) -> Scene:
     """A derivation's terminals: part = terminal row, label = terminal label."""
-    from ..interpreter.writers.meshes import bake, srgb8
+    from ..formats.meshes import bake, srgb8
 
     table = result.terminals if hasattr(result, "terminals") else result
     table.freeze()
@@ -163,8 +163,8 @@ def _glb_materials(gltf: dict) -> tuple[list[str], np.ndarray]:
 
 def from_gltf(path: str | os.PathLike) -> Scene:
     """A .glb or .gltf file, instances expanded (``read_glb``); parts and labels by material."""
+    from ..formats.glb_read import parse, read_glb
     from ..grammar.paths import read_input
-    from ..interpreter.writers.glb_read import parse, read_glb
 
     shown = str(path)
     try:

@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 import bgr
-from bgr.interpreter.writers import write_json
+from bgr.formats import write_json
 
 BOX = """Lot --> extrude(4) comp(f) {
     front: F | back: B | left: L | right: R | top: T | bottom: Bo

@@ -6,8 +6,8 @@ import json
 import pytest
 
 import bgr
+from bgr.formats import write_json
 from bgr.interpreter.split_solver import Piece, Repeat, solve
-from bgr.interpreter.writers import write_json
 
 
 def pieces(block: str, length: float = 10.0):

@@ -7,7 +7,7 @@ import sys
 import pytest
 from conftest import ROOT
 
-from bgr.interpreter.writers import read_glb
+from bgr.formats import read_glb
 
 EXAMPLES = [
     ("house.bgr", []),

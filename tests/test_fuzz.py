@@ -1423,7 +1423,7 @@ KNOWN_OUTSIDE: dict[tuple[str, str], str] = {}
 
 def derive_and_write(text: str, path: Path, out: Path) -> None:
     """load, fmt, a bounded derive, and the three writers: BgrError or success, in time."""
-    from bgr.interpreter.writers import write
+    from bgr.formats import write
 
     stage = "load"
     try:

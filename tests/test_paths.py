@@ -1,5 +1,5 @@
 """Files outside a grammar's reach: the import/asset root, regular files only in and out, SIGTERM
-and killed runs leave no temporaries (grammar/paths.py, interpreter/writers/atomic.py)."""
+and killed runs leave no temporaries (grammar/paths.py, formats/atomic.py)."""
 
 import os
 import signal
@@ -10,7 +10,7 @@ import time
 import pytest
 
 import bgr
-from bgr.interpreter.writers.atomic import is_stale, write_text
+from bgr.formats.atomic import is_stale, write_text
 
 SECRET = "TOP-SECRET-4242"
 needs_fifo = pytest.mark.skipif(not hasattr(os, "mkfifo"), reason="no FIFOs on this system")
@@ -231,7 +231,7 @@ def test_infer_and_write_text_refuse_a_fifo_output(tmp_path, root):
 
 SLOW_WRITE = """
 import sys, time
-import bgr.interpreter.writers as w
+import bgr.formats as w
 def slow(table, stream, **kwargs):
     stream.write(b"partial")
     stream.flush()

@@ -19,7 +19,7 @@ from hypothesis import strategies as st
 
 import bgr
 from bgr.cli import main
-from bgr.interpreter.writers import write_json
+from bgr.formats import write_json
 from bgr.inverse.schema import faces as fs
 from bgr.inverse.schema import infer, read_model
 

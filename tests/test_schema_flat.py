@@ -17,7 +17,7 @@ from conftest import ROOT
 
 import bgr
 from bgr.cli import main
-from bgr.interpreter.writers import write_json
+from bgr.formats import write_json
 from bgr.inverse.schema import check_derives, infer, read_model, source_lot
 from bgr.inverse.schema import faces as fs
 

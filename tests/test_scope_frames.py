@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 
 import bgr
-from bgr.interpreter.writers import write_json
+from bgr.formats import write_json
 
 
 def terminals(src: str, **kw) -> list[dict]:

@@ -15,10 +15,10 @@ import pytest
 import trimesh
 
 from bgr import BgrError
+from bgr.formats import glb as glb_module
+from bgr.formats import read_glb, to_trimesh, write, write_json
+from bgr.formats.glb_read import parse, quat_matrix
 from bgr.interpreter.terminals import TerminalTable, UnitMesh, color_hex
-from bgr.interpreter.writers import glb as glb_module
-from bgr.interpreter.writers import read_glb, to_trimesh, write, write_json
-from bgr.interpreter.writers.glb_read import parse, quat_matrix
 
 QUAD_V = [[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0]]
 QUAD_F = [[0, 1, 2], [0, 2, 3]]
@@ -157,7 +157,7 @@ def validate_glb(path: Path) -> dict:
         assert acc.get("byteOffset", 0) + acc["count"] * size <= view["byteLength"]
 
     def read(index: int) -> np.ndarray:
-        from bgr.interpreter.writers.glb_read import accessor
+        from bgr.formats.glb_read import accessor
 
         return accessor(gltf, blob, index)
 
@@ -371,7 +371,7 @@ def test_glb_normals_point_out(tmp_path):
     path = tmp_path / "n.glb"
     write(t, path, seed=0, attrs={})
     gltf, blob = parse(path.read_bytes())
-    from bgr.interpreter.writers.glb_read import accessor
+    from bgr.formats.glb_read import accessor
 
     prim = gltf["meshes"][0]["primitives"]
     for p in prim:
@@ -554,7 +554,7 @@ def test_unwritable_target_leaves_nothing(tmp_path):
 
 @pytest.mark.parametrize("fmt", FORMATS + ["json"])
 def test_failure_mid_write_leaves_nothing(tmp_path, monkeypatch, fmt):
-    import bgr.interpreter.writers as writers
+    import bgr.formats as writers
 
     def explode(*args, **kwargs):
         for stream in args[1:]:
@@ -571,7 +571,7 @@ def test_failure_mid_write_leaves_nothing(tmp_path, monkeypatch, fmt):
 
 
 def test_failure_keeps_the_previous_file(tmp_path, monkeypatch):
-    import bgr.interpreter.writers as writers
+    import bgr.formats as writers
 
     path = tmp_path / "out.glb"
     write(small_table(), path, seed=0, attrs={})

@@ -42,7 +42,7 @@ def read_model(
     if hasattr(source, "terminals") and hasattr(source, "attrs"):  # a bgr.Result
         import io
 
-        from bgr.interpreter.writers import write_json
+        from bgr.formats import write_json
 
         buffer = io.StringIO()
         write_json(source.terminals, buffer, seed=0, attrs={})

@@ -14,7 +14,7 @@ from dataclasses import dataclass
 import numpy as np
 import trimesh
 
-from ..terminals import TerminalTable
+from bgr.interpreter.terminals import TerminalTable
 
 
 @dataclass

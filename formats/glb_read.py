@@ -16,8 +16,8 @@ from pathlib import Path
 import numpy as np
 import trimesh
 
-from ...grammar.errors import BgrError
-from ...grammar.paths import read_input
+from bgr.grammar.errors import BgrError
+from bgr.grammar.paths import read_input
 
 _DTYPES = {5120: "i1", 5121: "u1", 5122: "<i2", 5123: "<u2", 5125: "<u4", 5126: "<f4"}
 _WIDTH = {"SCALAR": 1, "VEC2": 2, "VEC3": 3, "VEC4": 4, "MAT4": 16}

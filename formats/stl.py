@@ -7,7 +7,8 @@ from typing import BinaryIO
 import trimesh
 from trimesh.exchange.stl import export_stl
 
-from ..terminals import TerminalTable
+from bgr.interpreter.terminals import TerminalTable
+
 from .meshes import bake
 
 

@@ -8,7 +8,8 @@ import numpy as np
 import trimesh
 from trimesh.exchange.ply import export_ply
 
-from ..terminals import TerminalTable
+from bgr.interpreter.terminals import TerminalTable
+
 from .meshes import bake, srgb8
 
 

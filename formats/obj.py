@@ -12,7 +12,8 @@ from typing import BinaryIO
 
 import numpy as np
 
-from ..terminals import TerminalTable
+from bgr.interpreter.terminals import TerminalTable
+
 from .materials import Materials, materials_of
 from .meshes import bake
 

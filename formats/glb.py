@@ -16,7 +16,7 @@ face normal.  All data is little-endian float32, every bufferView starts on a 4-
 the output is a pure function of the table: writing the same table twice gives identical bytes.
 
 Readers without EXT_mesh_gpu_instancing (trimesh 5.2 among them) show one copy of each instanced
-group; :func:`bgr.interpreter.writers.read_glb` expands them.
+group; :func:`bgr.formats.read_glb` expands them.
 """
 
 from __future__ import annotations
@@ -29,8 +29,9 @@ from typing import BinaryIO
 
 import numpy as np
 
-from ...grammar.errors import BgrError
-from ..terminals import TerminalTable
+from bgr.grammar.errors import BgrError
+from bgr.interpreter.terminals import TerminalTable
+
 from .materials import Materials, materials_of
 from .meshes import (
     MeshPool,

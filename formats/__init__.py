@@ -1,6 +1,8 @@
-"""Output files from a terminal table (LANGUAGE.md section 11).
+"""File formats (LANGUAGE.md section 11): a module per format, its writer and (where the inverse
+modules or the renderer read it) its reader side by side.  The interpreter only makes the terminal
+table; every module that touches a file goes through this package.
 
-    from bgr.interpreter.writers import write, write_json, to_trimesh
+    from bgr.formats import write, write_json, to_trimesh
     write(table, Path("out.glb"), seed=3, attrs={"height": 18})     # format from the extension
     write(table, Path("-"), seed=3, attrs={}, fmt="json")            # the terminal list on stdout
 
@@ -17,9 +19,10 @@ from pathlib import Path
 
 import numpy as np
 
-from ...grammar.errors import BgrError, Diagnostic
-from ..limits import MAX_COORDINATE
-from ..terminals import TerminalTable
+from bgr.grammar.errors import BgrError, Diagnostic
+from bgr.interpreter.limits import MAX_COORDINATE
+from bgr.interpreter.terminals import TerminalTable
+
 from .atomic import atomic_files
 from .glb import write_glb, write_gltf
 from .glb_read import read_glb

@@ -10,7 +10,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..terminals import TerminalTable
+from bgr.interpreter.terminals import TerminalTable
+
 from .meshes import srgb8
 
 

@@ -13,8 +13,9 @@ from typing import BinaryIO, TextIO
 
 import numpy as np
 
-from ...grammar.errors import BgrError
-from ..terminals import TerminalTable
+from bgr.grammar.errors import BgrError
+from bgr.interpreter.terminals import TerminalTable
+
 from .meshes import srgb8
 
 

@@ -22,8 +22,8 @@ from collections.abc import Iterator
 from pathlib import Path
 from typing import BinaryIO
 
-from ...grammar.errors import BgrError, Diagnostic
-from ...grammar.paths import check_output
+from bgr.grammar.errors import BgrError, Diagnostic
+from bgr.grammar.paths import check_output
 
 # a temporary whose name carries no writer PID (an earlier bgr's, or another tool's) is stale
 # only once it is this old: no write of ours takes that long between open and rename
