@@ -89,6 +89,11 @@ def terminal_dicts(table: TerminalTable) -> list[dict]:
         ]
 
 
+# what the terminal list says of each lot: its frame (the inverse modules read a face's side in
+# it) and its name; the glTF and CityJSON files carry the attrs and feature properties too
+LOT_KEYS = ("path", "name", "origin", "axes", "size")
+
+
 def dumps(table: TerminalTable, *, seed: int, attrs: dict) -> str:
     """The whole document as text (ends with a newline)."""
     with _no_gc():
@@ -100,7 +105,9 @@ def _document(table: TerminalTable, seed: int, attrs: dict) -> str:
         f'{{\n  "bgr": 1,\n  "seed": {_dumps(seed)},\n  "attrs": {_dumps(attrs)},\n  "terminals": ['
     )
     rows = ",\n".join(["    " + _dumps(t) for t in terminal_dicts(table)])
-    lots = ",\n".join(["    " + _dumps(lot) for lot in table.lots])
+    lots = ",\n".join(
+        ["    " + _dumps({k: lot[k] for k in LOT_KEYS if k in lot}) for lot in table.lots]
+    )
     tail = ',\n  "lots": [\n' + lots + "\n  ]\n}\n" if lots else "\n}\n"
     return head + ("\n" + rows + "\n  ]" if rows else "]") + tail
 

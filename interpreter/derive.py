@@ -121,6 +121,7 @@ def derive(
                 max_memory=max_memory,
             )
             engine.table = table
+            first_row = len(table)
             engine.split_cache = shared_cache
             engine.shapes, engine.triangles = shapes, triangles
             engine.derive(each.shape.copy(), start, index=i, several=several)
@@ -135,6 +136,14 @@ def derive(
                 "origin": list(lot_shape.origin),
                 "axes": [list(a) for a in lot_shape.axes],
                 "size": list(lot_shape.size),
+                # what the output files say of the building: its terminals are rows
+                # first..last-1 (lots are derived one after another), its name, its attrs after
+                # the feature's overrides and the feature's own properties
+                "rows": [first_row, len(table)],
+                "id": each.feature_id,
+                "name": each.feature_id if each.feature_id is not None else f"lot-{i}",
+                "attrs": dict(engine.attrs),
+                "properties": dict(each.properties),
             }
         )
     return Result(table.freeze(), seed, values, list(warnings.items))

@@ -43,6 +43,7 @@ class Lot:
     properties: dict = field(default_factory=dict)
     name: str = ""  # how messages name it, e.g. "feature 12 (id 4253124)"; "" for --lot W,D
     source: str = ""  # the file it came from, where property warnings point
+    feature_id: str | None = None  # the GeoJSON feature's id (or "id" property), as a string
 
 
 class FootprintError(ValueError):
@@ -152,11 +153,12 @@ def read_geojson(path: Path, warnings: Warnings | None = None) -> list[Lot]:
             )
         )
 
-    rings = []  # (name, coordinates (k, 2), properties)
+    rings = []  # (name, coordinates (k, 2), properties, feature id)
     polygons = 0  # features with a Polygon or MultiPolygon geometry
     for i, feature in enumerate(features):
         feature = feature if isinstance(feature, dict) else {}
         name = feature_name(i, feature)
+        ident = feature_id(feature)
         properties = feature.get("properties")
         properties = properties if isinstance(properties, dict) else {}
         geometry = feature.get("geometry")
@@ -168,13 +170,14 @@ def read_geojson(path: Path, warnings: Warnings | None = None) -> list[Lot]:
             continue
         for part, ring in enumerate(outlines):
             part_name = f"{name}, part {part}" if len(outlines) > 1 else name
+            part_id = f"{ident}-{part}" if ident is not None and len(outlines) > 1 else ident
             if isinstance(ring, FootprintError):
                 skip(part_name, str(ring))
             else:
-                rings.append((part_name, ring, properties))
+                rings.append((part_name, ring, properties, part_id))
 
     lots = []
-    for name, ring, properties in _project(rings):
+    for name, ring, properties, ident in _project(rings):
         try:
             outline, note = clean_ring(ring)
         except FootprintError as e:
@@ -186,6 +189,7 @@ def read_geojson(path: Path, warnings: Warnings | None = None) -> list[Lot]:
             )
         lot = footprint([tuple(p) for p in outline], properties, name)
         lot.source = shown
+        lot.feature_id = ident
         lots.append(lot)
     if not lots:
         what = "no usable footprint" if polygons else "no Polygon features"
@@ -197,6 +201,17 @@ def read_geojson(path: Path, warnings: Warnings | None = None) -> list[Lot]:
 
 
 _POLYGONS = ("Polygon", "MultiPolygon")
+
+
+def feature_id(feature: dict) -> str | None:
+    """A feature's id as a string (GeoJSON's ``id`` member, else an ``id`` property, as
+    OpenStreetMap exports have); None without one.  Output files name buildings by it."""
+    ident = feature.get("id")
+    if ident is None and isinstance(feature.get("properties"), dict):
+        ident = feature["properties"].get("id")
+    if ident is None or isinstance(ident, (dict, list)):
+        return None
+    return ident if isinstance(ident, str) else _shown(ident)
 
 
 def feature_name(index: int, feature: dict) -> str:
@@ -273,7 +288,7 @@ def _project(items: list) -> list:
     """
     if not items:
         return []
-    flat = np.concatenate([ring for _, ring, _ in items])
+    flat = np.concatenate([item[1] for item in items])
     lo, hi = flat.min(axis=0), flat.max(axis=0)
     geographic = (
         bool((np.abs(flat[:, 0]) <= 180).all() and (np.abs(flat[:, 1]) <= 90).all())
@@ -293,7 +308,7 @@ def _project(items: list) -> list:
         )
     else:
         centre, scale = np.zeros(2), np.array([1.0, -1.0])
-    return [(name, (ring - centre) * scale, props) for (name, ring, props) in items]
+    return [(name, (ring - centre) * scale, *rest) for (name, ring, *rest) in items]
 
 
 # --------------------------------------------------------------------------------------------

@@ -63,8 +63,13 @@ class TerminalTable:
         default_factory=list
     )  # a list while deriving; frozen: (N,) int32 ids into library
     library: MeshLibrary = field(default_factory=MeshLibrary)
-    # per lot: {"path", "origin", "axes", "size"} (its frame)
+    # per lot: {"path", "origin", "axes", "size"} (its frame), "rows" [first, end) of its
+    # terminals, "id" (the feature's, or None), "name" (the id, or "lot-N"), "attrs" (after the
+    # feature's overrides), "properties" (the feature's)
     lots: list = field(default_factory=list)
+    # where local metres are on Earth, for geographic lots: {"crs": "EPSG:32635", "origin":
+    # [easting, northing, height]}: local x is easting - origin, local -z northing - origin
+    site: dict | None = None
     frozen: bool = False
 
     def __len__(self) -> int:
