@@ -105,6 +105,19 @@ def build_parser() -> argparse.ArgumentParser:
         metavar="W,D|LOTS.geojson",
         help="the lot: width,depth in metres (default 20,20) or GeoJSON footprints",
     )
+    derive.add_argument(
+        "--group-by",
+        choices=["lot", "label", "none"],
+        default="lot",
+        help="glTF scene tree: a node per lot holding a node per terminal label (lot, the "
+        "default), a node per label (label), or one node (none)",
+    )
+    derive.add_argument(
+        "--instancing",
+        action="store_true",
+        help="glTF: store repeated parts once with EXT_mesh_gpu_instancing (smaller files; "
+        "the extension is then required, so readers without it refuse the file)",
+    )
     add_budget_options(derive)
     derive.add_argument(
         "--strict",
@@ -469,7 +482,12 @@ def cmd_derive(args) -> int:
         write(result.terminals, Path("-"), seed=args.seed, attrs=result.attrs, fmt="json")
     else:
         write(
-            result.terminals, Path(args.output), seed=args.seed, attrs=result.attrs, fmt=args.format
+            result.terminals,
+            Path(args.output),
+            seed=args.seed,
+            attrs=result.attrs,
+            fmt=args.format,
+            gltf={"group_by": args.group_by, "instancing": "auto" if args.instancing else False},
         )
         print(
             f"{args.output}: {len(result):,} terminals, {result.terminals.triangle_count():,} "

@@ -43,6 +43,7 @@ FORMATS: dict[str, Callable[..., None]] = {
     "json": write_json_bytes,
 }
 EXTENSIONS = {f".{name}": name for name in FORMATS}
+GLTF = ("glb", "gltf")  # the formats that take the ``gltf`` options of write()
 NOT_YET = {".city.json": "CityJSON output is not implemented yet"}
 
 __all__ = [
@@ -111,14 +112,22 @@ def format_of(path: Path, fmt: str | None = None) -> str:
 
 
 def write(
-    table: TerminalTable, path: Path, *, seed: int, attrs: dict, fmt: str | None = None
+    table: TerminalTable,
+    path: Path,
+    *,
+    seed: int,
+    attrs: dict,
+    fmt: str | None = None,
+    gltf: dict | None = None,
 ) -> None:
     """Write ``table`` to ``path`` in the format of its extension, or ``fmt`` when given.
 
     ``path`` ``"-"`` writes to standard output and needs ``fmt`` (not ``obj``, which is two files).
-    For ``.obj`` the ``.mtl`` is written beside it, with the same stem.
+    For ``.obj`` the ``.mtl`` is written beside it, with the same stem.  ``gltf``: options of
+    the glTF writers (``group_by``, ``instancing``; see :func:`.glb.build`), ignored by others.
     """
     check_writable(table, attrs)
+    options = gltf or {}
     path = Path(path)
     if str(path) == "-":
         if fmt is None:
@@ -132,7 +141,8 @@ def write(
             )
         else:
             sys.stdout.flush()
-            FORMATS[name](table, sys.stdout.buffer, seed=seed, attrs=attrs)
+            extra = options if name in GLTF else {}
+            FORMATS[name](table, sys.stdout.buffer, seed=seed, attrs=attrs, **extra)
             sys.stdout.buffer.flush()
         return
 
@@ -143,4 +153,5 @@ def write(
             write_obj(table, f_obj, f_mtl, mtl_name=mtl.name, seed=seed, attrs=attrs)
     else:
         with atomic_files([path]) as (f,):
-            FORMATS[name](table, f, seed=seed, attrs=attrs)
+            extra = options if name in GLTF else {}
+            FORMATS[name](table, f, seed=seed, attrs=attrs, **extra)

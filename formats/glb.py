@@ -1,22 +1,28 @@
 """glTF 2.0 output (.glb and .gltf), built directly with numpy: the main output format.
 
-Layout of the file:
+Layout of the file (checked by the Khronos glTF validator in tests/test_gltf_validator.py):
 
-* one material per distinct (colour, material name) pair (:mod:`.materials`), PBR with the colour
-  as ``baseColorFactor`` in linear light;
-* node ``terminals``: every terminal that is not instanced, baked to world space, one primitive per
-  material;
-* one node per instanced (unit mesh, material) group: the unit mesh stored once and placed by the
-  ``EXT_mesh_gpu_instancing`` TRANSLATION / ROTATION / SCALE attributes.  A group is instanced
-  when that makes the file smaller (:func:`plan`), so ``extensionsUsed`` names the extension only
-  when some group is.
+* a scene tree people can work with: a root node ``bgr`` whose extras hold the grammar, seed,
+  attrs, bgr version, and the CRS and origin of geographic lots; a node per lot named by its
+  feature id or ``lot-N`` (extras: its attrs and feature properties); under it a node per
+  terminal label (``Window``, ``Wall``, ...) whose mesh has one primitive per material
+  (``group_by="lot"``, the default; ``"label"`` and ``"none"`` flatten it);
+* one material per distinct (colour, material name) pair (:mod:`.materials`), shared by the
+  whole file, PBR with the colour as ``baseColorFactor`` in linear light;
+* every accessor has its own bufferView (no ``byteStride`` needed), POSITION with min/max.
+
+**Instancing is off by default**: every terminal is baked to world space, so every reader sees
+every triangle (trimesh and the Khronos validator do not know ``EXT_mesh_gpu_instancing``;
+Blender's importer turns each instance into an object of its own; three.js makes an
+InstancedMesh).  ``instancing="auto"`` (``bgr derive --instancing``) stores a repeated unit
+mesh once with per-instance TRANSLATION / ROTATION / SCALE where that makes the file smaller
+(:func:`plan`), and then lists the extension in ``extensionsRequired`` as well as
+``extensionsUsed``, so that a reader without it refuses the file instead of showing one copy.
 
 Triangles are flat shaded: every triangle has its own three vertices (no index buffer) carrying the
 face normal.  All data is little-endian float32, every bufferView starts on a 4-byte boundary, and
 the output is a pure function of the table: writing the same table twice gives identical bytes.
-
-Readers without EXT_mesh_gpu_instancing (trimesh 5.2 among them) show one copy of each instanced
-group; :func:`bgr.formats.read_glb` expands them.
+:func:`bgr.formats.read_glb` reads it back, expanding instances.
 """
 
 from __future__ import annotations
@@ -64,7 +70,11 @@ class Plan:
 
 
 def plan(
-    table: TerminalTable, pool: MeshPool, mats: Materials, instancing: str | bool = "auto"
+    table: TerminalTable,
+    pool: MeshPool,
+    mats: Materials,
+    instancing: str | bool = "auto",
+    major: np.ndarray | None = None,
 ) -> Plan:
     """Which terminals to instance.
 
@@ -90,7 +100,9 @@ def plan(
         eligible[:] = False
 
     n_mesh = max(len(pool.vcount), 1)
-    key = mats.index * n_mesh + mesh
+    if major is None:  # the file's grouping of rows (scene group and material); else material
+        major = mats.index.astype(np.int64)
+    key = major * n_mesh + mesh
     keys, counts = np.unique(key[eligible], return_counts=True)
     faces = pool.fcount[keys % n_mesh]
     stored = faces * 3 * CORNER_BYTES
@@ -111,7 +123,7 @@ def plan(
         for grp in np.split(rows, cuts):
             groups.append((int(mesh[grp[0]]), int(mats.index[grp[0]]), grp))
     baked = np.flatnonzero(~instanced)
-    baked = shape_order(table, baked, pool, mats.index[baked])
+    baked = shape_order(table, baked, pool, major[baked])
     return Plan(baked=baked, groups=groups, scale=scale)
 
 
@@ -179,45 +191,43 @@ def quaternions(axes: np.ndarray) -> np.ndarray:
 
 
 class _Builder:
-    """bufferViews and float32 accessors over one preallocated little-endian buffer."""
+    """float32 blocks in one preallocated little-endian buffer, and a bufferView per accessor
+    (glTF wants a ``byteStride`` when accessors share a view; one view each needs none)."""
 
     def __init__(self, nbytes: int) -> None:
         self.bin = np.zeros(nbytes, dtype=np.uint8)
         self.offset = 0
         self.views: list[dict] = []
         self.accessors: list[dict] = []
-        self._data: list[np.ndarray] = []
 
-    def view(
-        self, count: int, width: int, target: int | None = ARRAY_BUFFER
-    ) -> tuple[int, np.ndarray]:
-        """Reserve ``count`` float32 VEC<width>: the bufferView's index and an array to fill."""
+    def block(self, count: int, width: int) -> tuple[int, np.ndarray]:
+        """Reserve ``count`` float32 VEC<width>: the block's byte offset and an array to fill."""
         length = count * width * 4  # a multiple of 4, so every view stays 4-byte aligned
-        view = {"buffer": 0, "byteOffset": self.offset, "byteLength": length}
+        start = self.offset
+        self.offset += length
+        return start, self.bin[start : start + length].view("<f4").reshape(count, width)
+
+    def accessor(
+        self,
+        start: int,
+        data: np.ndarray,
+        target: int | None = ARRAY_BUFFER,
+        bounded: bool = False,
+    ) -> int:
+        """A view on ``data`` (rows of a block starting at byte ``start``) and its accessor,
+        with min/max if ``bounded`` (POSITION needs them)."""
+        view = {"buffer": 0, "byteOffset": start, "byteLength": int(data.nbytes)}
         if target is not None:
             view["target"] = target
         self.views.append(view)
-        data = self.bin[self.offset : self.offset + length].view("<f4").reshape(count, width)
-        self._data.append(data)
-        self.offset += length
-        return len(self.views) - 1, data
-
-    def accessor(
-        self, view: int, first: int = 0, count: int | None = None, bounded: bool = False
-    ) -> int:
-        """An accessor on elements ``first:first + count`` of a view, min/max if ``bounded``."""
-        data = self._data[view]
-        count = len(data) - first if count is None else count
         acc = {
-            "bufferView": view,
+            "bufferView": len(self.views) - 1,
             "componentType": FLOAT,
-            "count": count,
+            "count": len(data),
             "type": f"VEC{data.shape[1]}",
         }
-        if first:
-            acc["byteOffset"] = first * data.shape[1] * 4
         if bounded:
-            lo, hi = bounds(data[first : first + count])
+            lo, hi = bounds(data)
             acc["min"], acc["max"] = [float(v) for v in lo], [float(v) for v in hi]
         self.accessors.append(acc)
         return len(self.accessors) - 1
@@ -225,28 +235,90 @@ class _Builder:
     def vec(
         self, values: np.ndarray, target: int | None = ARRAY_BUFFER, bounded: bool = False
     ) -> int:
-        """A view and its accessor holding ``values`` (n, width)."""
-        view, data = self.view(len(values), values.shape[1], target)
+        """A block, its view and its accessor holding ``values`` (n, width)."""
+        start, data = self.block(len(values), values.shape[1])
         data[:] = values
-        return self.accessor(view, bounded=bounded)
+        return self.accessor(start, data, target, bounded)
 
 
 def recentre(table: TerminalTable, limit: float = 4096.0) -> np.ndarray:
-    """A whole-metre offset to subtract from positions (and put back as the node translation)
-    when the scene lies far from the origin, where float32 would lose millimetres; else zeros."""
+    """A whole-metre offset to subtract from positions (and put back as the root node's
+    translation) when the scene lies far from the origin, where float32 would lose millimetres;
+    else zeros."""
     if len(table) == 0 or np.abs(table.origin).max() <= limit:
         return np.zeros(3)
     return np.round((table.origin.min(axis=0) + table.origin.max(axis=0)) / 2) + 0.0
 
 
+GROUPINGS = ("lot", "label", "none")
+
+
+@dataclass
+class Groups:
+    """The scene's grouping of terminals: ``of_row`` the group of every table row, and per
+    group its parent lot (or -1 at the root) and its node name."""
+
+    of_row: np.ndarray
+    lot: list[int]
+    name: list[str]
+
+
+def groups_of(table: TerminalTable, group_by: str) -> Groups:
+    """Terminals by (lot, label), by label, or all in one group."""
+    n = len(table)
+    if group_by == "none" or n == 0:
+        return Groups(np.zeros(n, dtype=np.int64), [-1], ["terminals"])
+    labels, label_of = np.unique(np.asarray(table.label, dtype=object), return_inverse=True)
+    label_of = label_of.astype(np.int64)
+    if group_by == "label":
+        return Groups(label_of, [-1] * len(labels), [str(v) for v in labels])
+    lot_of = lot_rows(table)
+    key = lot_of * len(labels) + label_of
+    keys, of_row = np.unique(key, return_inverse=True)
+    return Groups(
+        of_row.astype(np.int64),
+        [int(k) // len(labels) for k in keys],
+        [str(labels[int(k) % len(labels)]) for k in keys],
+    )
+
+
+def lot_rows(table: TerminalTable) -> np.ndarray:
+    """The lot of every terminal row, from each lot's ``rows`` range (0 for rows outside)."""
+    out = np.zeros(len(table), dtype=np.int64)
+    for i, lot in enumerate(table.lots):
+        first, end = lot.get("rows", (0, 0))
+        out[first:end] = i
+    return out
+
+
 def build(
-    table: TerminalTable, *, seed: int, attrs: dict, instancing: str | bool = "auto"
+    table: TerminalTable,
+    *,
+    seed: int,
+    attrs: dict,
+    instancing: str | bool = False,
+    group_by: str = "lot",
 ) -> tuple[dict, np.ndarray]:
-    """The glTF JSON document and its binary buffer (uint8) for a table."""
+    """The glTF JSON document and its binary buffer (uint8) for a table.
+
+    The scene is one root node ``bgr`` (extras: grammar, seed, attrs, bgr version, and the CRS
+    and origin of geographic lots); under it, with ``group_by="lot"``, a node per lot named by
+    its feature id or ``lot-N`` (extras: its attrs and feature properties) holding a node per
+    terminal label; with ``"label"`` the label nodes sit under the root; with ``"none"`` the
+    root holds every terminal.  A node's mesh has one primitive per material; materials are
+    shared by the whole file.  ``instancing``: see :func:`plan` (off by default: every reader
+    then sees every triangle).
+    """
+    if group_by not in GROUPINGS:
+        raise BgrError(f"unknown grouping '{group_by}': use one of {', '.join(GROUPINGS)}")
     table.freeze()
     pool = MeshPool.of(table)
     mats = materials_of(table)
-    p = plan(table, pool, mats, instancing)
+    groups = groups_of(table, group_by)
+    n_groups = len(groups.name)
+    # a row's instancing group and place in the file: its scene group first, then material
+    major = groups.of_row * max(len(mats), 1) + mats.index
+    p = plan(table, pool, mats, instancing, major)
 
     fstart = face_offsets(table, p.baked, pool)
     n_corner = 3 * int(fstart[-1])
@@ -254,39 +326,73 @@ def build(
     for mesh_id, _, rows in p.groups:
         nbytes += int(pool.fcount[mesh_id]) * 3 * CORNER_BYTES + len(rows) * INSTANCE_BYTES
     b = _Builder(nbytes)
-    meshes, nodes = [], []
     shift = recentre(table)
-    place = {"translation": shift.tolist()} if shift.any() else {}
 
-    # baked terminals: one view per attribute, one primitive (a slice of them) per material
+    # baked terminals: one primitive per (group, material), a slice of two big blocks
+    prims: list[list[dict]] = [[] for _ in range(n_groups)]
     if n_corner:
-        pos_view, pos_data = b.view(n_corner, 3)
-        nrm_view, nrm_data = b.view(n_corner, 3)
+        pos_at, pos_data = b.block(n_corner, 3)
+        nrm_at, nrm_data = b.block(n_corner, 3)
         place_corners(
             table, p.baked, pool, pos_data.reshape(-1, 3, 3), nrm_data.reshape(-1, 3, 3), shift
         )
-        mat_of_row = mats.index[p.baked]
-        cuts = np.flatnonzero(np.diff(mat_of_row)) + 1
-        prims = []
+        key = major[p.baked]
+        cuts = np.flatnonzero(np.diff(key)) + 1
         for lo, hi in zip(
-            np.concatenate([[0], cuts]), np.concatenate([cuts, [len(mat_of_row)]]), strict=True
+            np.concatenate([[0], cuts]), np.concatenate([cuts, [len(key)]]), strict=True
         ):
-            first, count = 3 * int(fstart[lo]), 3 * int(fstart[hi] - fstart[lo])
-            if count:
-                prims.append(
+            first, end = 3 * int(fstart[lo]), 3 * int(fstart[hi])
+            if end > first:
+                row = p.baked[lo]
+                prims[int(groups.of_row[row])].append(
                     {
                         "attributes": {
-                            "POSITION": b.accessor(pos_view, first, count, bounded=True),
-                            "NORMAL": b.accessor(nrm_view, first, count),
+                            "POSITION": b.accessor(
+                                pos_at + first * 12, pos_data[first:end], bounded=True
+                            ),
+                            "NORMAL": b.accessor(nrm_at + first * 12, nrm_data[first:end]),
                         },
-                        "material": int(mat_of_row[lo]),
+                        "material": int(mats.index[row]),
                         "mode": 4,
                     }
                 )
-        meshes.append({"name": "terminals", "primitives": prims})
-        nodes.append({"name": "terminals", "mesh": 0, **place})
 
-    # instanced groups: the unit mesh once, one node with per-instance TRS
+    meshes: list[dict] = []
+    nodes: list[dict] = [{"name": "bgr", "children": []}]
+    if shift.any():
+        nodes[0]["translation"] = shift.tolist()
+    nodes[0]["extras"] = root_extras(table, seed, attrs)
+    lot_node: dict[int, dict] = {}
+
+    def parent_of(group: int) -> dict:
+        lot = groups.lot[group]
+        if lot < 0:
+            return nodes[0]
+        if lot not in lot_node:
+            lot_node[lot] = node = lot_extras(table, lot)
+            nodes.append(node)
+            nodes[0]["children"].append(len(nodes) - 1)
+        return lot_node[lot]
+
+    group_node: dict[int, dict] = {}
+
+    def node_of(group: int) -> dict:
+        if group not in group_node:
+            if group_by == "none":
+                group_node[group] = nodes[0]
+            else:
+                parent = parent_of(group)
+                nodes.append({"name": groups.name[group]})
+                parent.setdefault("children", []).append(len(nodes) - 1)
+                group_node[group] = nodes[-1]
+        return group_node[group]
+
+    for group in range(n_groups):
+        if prims[group]:
+            meshes.append({"name": groups.name[group], "primitives": prims[group]})
+            node_of(group)["mesh"] = len(meshes) - 1
+
+    # instanced groups (opt-in): the unit mesh once, a child node with per-instance TRS
     names = [m.name for m in table.library.meshes]
     for mesh_id, mat, rows in p.groups:
         unit = pool.vertices[pool.voff[mesh_id] : pool.voff[mesh_id] + pool.vcount[mesh_id]]
@@ -308,15 +414,18 @@ def build(
                 ],
             }
         )
+        parent = node_of(int(groups.of_row[rows[0]]))
         nodes.append(
             {
                 "name": name,
                 "mesh": len(meshes) - 1,
-                **place,
                 "extensions": {INSTANCING: {"attributes": trs}},
             }
         )
+        parent.setdefault("children", []).append(len(nodes) - 1)
     assert b.offset == nbytes
+    if not nodes[0]["children"]:
+        del nodes[0]["children"]
 
     gltf: dict = {
         "asset": {
@@ -325,14 +434,16 @@ def build(
             "extras": {"bgr": 1, "seed": seed, "attrs": attrs},
         }
     }
-    if p.groups:
+    if p.groups:  # a reader without the extension must refuse the file, not drop geometry
         gltf["extensionsUsed"] = [INSTANCING]
+        gltf["extensionsRequired"] = [INSTANCING]
     gltf["scene"] = 0
-    gltf["scenes"] = [{"name": "bgr", "nodes": list(range(len(nodes)))}]
+    gltf["scenes"] = [{"name": "bgr", "nodes": [0]}]
     gltf["nodes"] = nodes
     if meshes:
         gltf["meshes"] = meshes
-    if len(mats):
+    used = sorted({prim["material"] for mesh in meshes for prim in mesh["primitives"]})
+    if used:
         gltf["materials"] = [
             {
                 "name": mats.labels[k],
@@ -351,6 +462,29 @@ def build(
         gltf["bufferViews"] = b.views
         gltf["buffers"] = [{"byteLength": int(b.bin.nbytes)}]
     return gltf, b.bin
+
+
+def root_extras(table: TerminalTable, seed: int, attrs: dict) -> dict:
+    """What the root node says of the run: grammar, seed, attrs, version; where it lies."""
+    extras: dict = {"bgr": _version(), "seed": seed, "attrs": attrs}
+    grammar = getattr(table, "grammar", None)
+    if grammar:
+        extras["grammar"] = grammar
+    if table.site:
+        extras["crs"] = table.site.get("crs")
+        extras["origin"] = table.site.get("origin")
+        extras["axes"] = "x east, y up, z south; a position is origin + (x, -z, y) in the CRS"
+    return extras
+
+
+def lot_extras(table: TerminalTable, index: int) -> dict:
+    """A lot's node: named by its feature id (or ``lot-N``), with its attrs and properties."""
+    lot = table.lots[index] if index < len(table.lots) else {}
+    extras: dict = {"path": lot.get("path", "")}
+    for key in ("id", "attrs", "properties"):
+        if lot.get(key) is not None:
+            extras[key] = lot[key]
+    return {"name": str(lot.get("name", f"lot-{index}")), "extras": extras}
 
 
 def _version() -> str:
@@ -378,13 +512,14 @@ def write_glb(
     *,
     seed: int,
     attrs: dict,
-    instancing: str | bool = "auto",
+    instancing: str | bool = False,
+    group_by: str = "lot",
 ) -> None:
     """A binary glTF: header, JSON chunk (space-padded), BIN chunk.
 
-    ``instancing``: see :func:`plan`.
+    ``instancing`` and ``group_by``: see :func:`build`.
     """
-    gltf, bin_ = build(table, seed=seed, attrs=attrs, instancing=instancing)
+    gltf, bin_ = build(table, seed=seed, attrs=attrs, instancing=instancing, group_by=group_by)
     text = _json_bytes(gltf)
     text += b" " * (-len(text) % 4)
     chunks: list[bytes | np.ndarray] = [struct.pack("<II", len(text), 0x4E4F534A), text]
@@ -402,10 +537,11 @@ def write_gltf(
     *,
     seed: int,
     attrs: dict,
-    instancing: str | bool = "auto",
+    instancing: str | bool = False,
+    group_by: str = "lot",
 ) -> None:
     """One self-contained .gltf: JSON with the buffer as a base64 data URI."""
-    gltf, bin_ = build(table, seed=seed, attrs=attrs, instancing=instancing)
+    gltf, bin_ = build(table, seed=seed, attrs=attrs, instancing=instancing, group_by=group_by)
     if bin_.nbytes:
         gltf["buffers"][0]["uri"] = "data:application/octet-stream;base64," + base64.b64encode(
             bin_.tobytes()

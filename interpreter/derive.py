@@ -100,6 +100,7 @@ def derive(
     if max_memory is None:
         max_memory = default_max_memory()
     table = TerminalTable()
+    table.grammar = str(grammar.path or "")
     shared_cache: dict = {}
     shapes = triangles = 0  # the budgets are the run's, carried from lot to lot
     several = len(lots) > 1

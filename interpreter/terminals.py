@@ -70,6 +70,7 @@ class TerminalTable:
     # where local metres are on Earth, for geographic lots: {"crs": "EPSG:32635", "origin":
     # [easting, northing, height]}: local x is easting - origin, local -z northing - origin
     site: dict | None = None
+    grammar: str = ""  # the grammar's file (or "<string>"): the glTF root's extras name it
     frozen: bool = False
 
     def __len__(self) -> int:

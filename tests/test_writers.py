@@ -251,8 +251,13 @@ def test_gltf_loads_with_pygltflib(tmp_path, fmt):
     write(city_table(), path, seed=0, attrs={})
     doc = pygltflib.GLTF2().load(str(path))
     assert doc.asset.version == "2.0"
-    assert "EXT_mesh_gpu_instancing" in doc.extensionsUsed
+    assert not doc.extensionsUsed and not doc.extensionsRequired  # baked by default
     assert len(doc.materials) == 4
+    assert doc.nodes[doc.scenes[0].nodes[0]].name == "bgr"
+    # opted in, the extension is required: a reader without it refuses the file
+    write(city_table(), path, seed=0, attrs={}, gltf={"instancing": "auto"})
+    doc = pygltflib.GLTF2().load(str(path))
+    assert doc.extensionsUsed == doc.extensionsRequired == ["EXT_mesh_gpu_instancing"]
 
 
 def test_to_trimesh():
@@ -395,12 +400,11 @@ def test_glb_normals_point_out(tmp_path):
 def test_instancing_round_trips(tmp_path):
     t = city_table()
     inst, flat = tmp_path / "inst.glb", tmp_path / "flat.glb"
-    write(t, inst, seed=0, attrs={})
-    with open(flat, "wb") as f:
-        glb_module.write_glb(t, f, seed=0, attrs={}, instancing=False)
+    write(t, inst, seed=0, attrs={}, gltf={"instancing": "auto"})
+    write(t, flat, seed=0, attrs={})  # the default: every terminal baked
     g_inst, g_flat = validate_glb(inst), validate_glb(flat)
-    assert g_inst["extensionsUsed"] == ["EXT_mesh_gpu_instancing"]
-    assert "extensionsUsed" not in g_flat
+    assert g_inst["extensionsUsed"] == g_inst["extensionsRequired"] == ["EXT_mesh_gpu_instancing"]
+    assert "extensionsUsed" not in g_flat and "extensionsRequired" not in g_flat
     instanced = [n for n in g_inst["nodes"] if "extensions" in n]
     # boxes (40 of one colour) and windows (30, zero depth: scale 1 on z) are instanced
     assert sorted(n["name"] for n in instanced) == ["cube #99998c", "quad glass"]
@@ -500,7 +504,7 @@ def test_empty_table_glb(tmp_path):
     path = tmp_path / "e.glb"
     write(TerminalTable().freeze(), path, seed=0, attrs={})
     gltf = validate_glb(path)
-    assert gltf["nodes"] == [] and "buffers" not in gltf
+    assert [node["name"] for node in gltf["nodes"]] == ["bgr"] and "buffers" not in gltf
     pygltflib.GLTF2().load(str(path))
 
 
