@@ -47,7 +47,8 @@ class Result:
         return to_trimesh(self.terminals)
 
     def save(self, path: str | os.PathLike, fmt: str | None = None) -> None:
-        """Write by extension (.glb .gltf .obj .ply .stl .json), atomically."""
+        """Write by extension (.glb .gltf .obj .ply .stl .json .city.json .city.jsonl),
+        atomically."""
         from bgr.formats import write
 
         write(self.terminals, Path(path), seed=self.seed, attrs=self.attrs, fmt=fmt)
