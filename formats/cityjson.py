@@ -276,10 +276,10 @@ def _masses(tris: Triangles, mine: np.ndarray, axes: list | None) -> list[np.nda
     pending = [(np.arange(len(rows)), 0, False)]
     while pending:
         members, axis, tried_other = pending.pop()
-        pieces = _cut(lo, hi, members, axis)
+        pieces = _cut(lo, hi, members, axis) if len(members) > 1 else [members]
         if len(pieces) > 1:
             pending += [(p, 1 - axis, False) for p in pieces]
-        elif not tried_other:
+        elif not tried_other and len(members) > 1:
             pending.append((members, 1 - axis, True))
         else:
             groups.append(np.sort(members))

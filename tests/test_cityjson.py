@@ -376,6 +376,36 @@ def test_separate_masses_of_one_lot_are_building_parts(tmp_path):
     assert "children" not in house and house["geometry"][0]["lod"] == "3"
 
 
+BOX_V = [[x, y, z] for x in (0, 1) for y in (0, 1) for z in (0, 1)]
+BOX_F = [
+    [0, 1, 3], [0, 3, 2], [4, 6, 7], [4, 7, 5], [0, 4, 5], [0, 5, 1],
+    [2, 3, 7], [2, 7, 6], [0, 2, 6], [0, 6, 4], [1, 5, 7], [1, 7, 3],
+]  # fmt: skip
+
+
+def test_parts_are_found_by_cuts_along_one_axis_then_the_other(tmp_path):
+    # A and B share x 0..1 but not z; C stands apart along x; D touches C (no gap): C's mass
+    t = TerminalTable()
+    box = t.library.add(UnitMesh("cube", BOX_V, BOX_F))
+    for label, x, z, size in [
+        ("A", 0.0, 0.0, (1.0, 3.0, 1.0)),
+        ("B", 0.0, 5.0, (1.0, 3.0, 1.0)),
+        ("C", 5.0, 0.0, (1.0, 3.0, 6.0)),
+        ("D", 6.0, 2.0, (2.0, 3.0, 1.0)),
+        ("A2", 0.5, 0.995, (0.2, 5.0, 0.2)),  # 5 mm from A: not a gap of over 1 cm
+    ]:
+        add(t, label, box, (x, 0.0, z), SIDE, size=size)
+    t.freeze()
+    path = written(t, tmp_path)
+    valid(path)
+    objects = json.loads(path.read_text())["CityObjects"]
+    model = read_cityjson(path).objects
+    assert objects["lot-0"]["children"] == ["lot-0-part-1", "lot-0-part-2", "lot-0-part-3"]
+    # each part's triangles: 12 per box, its boxes in table order
+    assert [len(model[f"lot-0-part-{k}"].faces) for k in (1, 2, 3)] == [24, 12, 24]
+    assert model["lot-0-part-2"].vertices[:, 1].min() == pytest.approx(-6.0)  # B: z 5..6
+
+
 def test_a_table_without_terminals_is_a_building_without_geometry(tmp_path):
     path = written(TerminalTable().freeze(), tmp_path)
     valid(path)
