@@ -93,6 +93,16 @@ def _glb(t, path: Path, instancing) -> None:
             write_glb(t, f, seed=0, attrs={}, instancing=False)
 
 
+def cityjson_rows(t: TerminalTable, folder: Path, repeat: int) -> None:
+    """CityJSON and CityJSON Text Sequences of the table (one Building: it has no lots; its
+    terminals are cut into BuildingParts wherever gaps separate them in plan)."""
+    for ext in ("city.json", "city.jsonl"):
+        path = folder / f"bench.{ext}"
+        median, best = timed(functools.partial(write, t, path, seed=0, attrs={}), repeat)
+        size = path.stat().st_size / 1e6
+        print(f"{ext:21s}: median {median:.3f} s, best {best:.3f} s, {size:.1f} MB")
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--triangles", type=int, default=1_000_000)
@@ -125,6 +135,7 @@ def main() -> None:
             path = Path(tmp) / f"bench.{ext}"
             median, best = timed(functools.partial(write, t, path, seed=0, attrs={}), 1)
             print(f"{ext:21s}: {median:.3f} s, {path.stat().st_size / 1e6:.1f} MB")
+        cityjson_rows(t, Path(tmp), min(args.repeat, 3))
 
 
 if __name__ == "__main__":

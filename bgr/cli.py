@@ -81,7 +81,8 @@ def build_parser() -> argparse.ArgumentParser:
         "derive",
         help="derive a grammar into a mesh or a terminal list",
         description="Derive FILE.bgr on a lot and write the result; the "
-        "format follows the output's extension (.glb .gltf .obj .ply .stl .json).",
+        "format follows the output's extension "
+        "(.glb .gltf .obj .ply .stl .json .city.json .city.jsonl).",
     )
     derive.add_argument("file", metavar="FILE.bgr")
     derive.add_argument(
@@ -89,7 +90,7 @@ def build_parser() -> argparse.ArgumentParser:
     )
     derive.add_argument(
         "--format",
-        choices=["glb", "gltf", "obj", "ply", "stl", "json"],
+        choices=["glb", "gltf", "obj", "ply", "stl", "json", "city.json", "city.jsonl"],
         help="output format when the extension does not say it (json for stdout)",
     )
     derive.add_argument("--seed", type=_whole, default=0, help="global random seed (default 0)")

@@ -24,6 +24,7 @@ from bgr.interpreter.limits import MAX_COORDINATE
 from bgr.interpreter.terminals import TerminalTable
 
 from .atomic import atomic_files
+from .cityjson import read_cityjson, write_cityjson, write_cityjsonseq
 from .glb import write_glb, write_gltf
 from .glb_read import read_glb
 from .meshes import bake, to_trimesh
@@ -41,16 +42,18 @@ FORMATS: dict[str, Callable[..., None]] = {
     "ply": write_ply,
     "stl": write_stl,
     "json": write_json_bytes,
+    "city.json": write_cityjson,
+    "city.jsonl": write_cityjsonseq,
 }
 EXTENSIONS = {f".{name}": name for name in FORMATS}
 GLTF = ("glb", "gltf")  # the formats that take the ``gltf`` options of write()
-NOT_YET = {".city.json": "CityJSON output is not implemented yet"}
 
 __all__ = [
     "write",
     "write_json",
     "to_trimesh",
     "read_glb",
+    "read_cityjson",
     "bake",
     "format_of",
     "check_writable",
@@ -96,19 +99,18 @@ def format_of(path: Path, fmt: str | None = None) -> str:
         if name not in FORMATS:
             raise BgrError(f"unknown output format '{fmt}'; known formats: {', '.join(FORMATS)}")
         return name
-    lower = str(path).lower()
-    for ext, why in NOT_YET.items():
-        if lower.endswith(ext):
-            raise BgrError(Diagnostic(str(path), 0, 0, why, _known()))
-    suffix = Path(lower).suffix
-    if suffix not in EXTENSIONS:
-        shown = (
-            f"unknown output extension '{suffix}'"
-            if suffix
-            else "the output file name has no extension"
-        )
-        raise BgrError(Diagnostic(str(path), 0, 0, shown, _known()))
-    return EXTENSIONS[suffix]
+    name = Path(str(path).lower()).name
+    # the longest extension first, so that .city.json is CityJSON and not the terminal list
+    for ext in sorted(EXTENSIONS, key=len, reverse=True):
+        if name.endswith(ext) and len(name) > len(ext):
+            return EXTENSIONS[ext]
+    suffix = Path(name).suffix
+    shown = (
+        f"unknown output extension '{suffix}'"
+        if suffix
+        else "the output file name has no extension"
+    )
+    raise BgrError(Diagnostic(str(path), 0, 0, shown, _known()))
 
 
 def write(

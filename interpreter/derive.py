@@ -47,7 +47,8 @@ class Result:
         return to_trimesh(self.terminals)
 
     def save(self, path: str | os.PathLike, fmt: str | None = None) -> None:
-        """Write by extension (.glb .gltf .obj .ply .stl .json), atomically."""
+        """Write by extension (.glb .gltf .obj .ply .stl .json .city.json .city.jsonl),
+        atomically."""
         from bgr.formats import write
 
         write(self.terminals, Path(path), seed=self.seed, attrs=self.attrs, fmt=fmt)
@@ -99,7 +100,7 @@ def derive(
     values = Engine(grammar, seed, attrs, max_depth, max_shapes).attrs  # the run's attrs
     if max_memory is None:
         max_memory = default_max_memory()
-    table = TerminalTable()
+    table = TerminalTable(site=_site(lots))
     table.grammar = str(grammar.path or "")
     shared_cache: dict = {}
     shapes = triangles = 0  # the budgets are the run's, carried from lot to lot
@@ -148,6 +149,19 @@ def derive(
             }
         )
     return Result(table.freeze(), seed, values, list(warnings.items))
+
+
+def _site(lots: list[Lot]) -> dict | None:
+    """Where the run's local metres are on Earth (TerminalTable.site): the lots' common site
+    (read_geojson gives every lot of a file the same one), None for plain metres.  Lots placed
+    in different CRSs or about different origins cannot share one output file."""
+    site = lots[0].site
+    if any(each.site != site for each in lots):
+        raise BgrError(
+            "the lots are placed in different coordinate systems (their site differs); derive "
+            "lots of one GeoJSON file, or lots in plain metres, together"
+        )
+    return None if site is None else {"crs": site["crs"], "origin": list(site["origin"])}
 
 
 def _naming(error: BgrError, lot_name: str) -> BgrError:

@@ -32,9 +32,8 @@ DEFAULT_LOT = (20.0, 20.0)
 CLEAN_TOL = 1e-3  # metres: a corner this close to the previous one or to a straight line goes
 MIN_WIDTH = 0.05  # metres: an outline whose mean width (2 area / perimeter) is less is skipped
 
-# WGS84: the local projection of longitude/latitude uses the ellipsoid's radii of curvature
-_WGS84_A = 6_378_137.0
-_WGS84_E2 = 6.694_379_990_14e-3
+# GeoJSON's own CRS (RFC 7946): longitude, latitude on WGS84
+CRS84 = "OGC:CRS84"
 
 
 @dataclass
@@ -44,6 +43,9 @@ class Lot:
     name: str = ""  # how messages name it, e.g. "feature 12 (id 4253124)"; "" for --lot W,D
     source: str = ""  # the file it came from, where property warnings point
     feature_id: str | None = None  # the GeoJSON feature's id (or "id" property), as a string
+    # where its local metres are on Earth, for lots of a file with a known CRS (see _project):
+    # {"crs": "EPSG:32635", "origin": [easting, northing, height]}; None for plain metres
+    site: dict | None = None
 
 
 class FootprintError(ValueError):
@@ -122,9 +124,11 @@ def parse_lot_option(value: str, warnings: Warnings | None = None) -> list[Lot]:
 def read_geojson(path: Path, warnings: Warnings | None = None) -> list[Lot]:
     """Every Polygon / MultiPolygon feature becomes a lot (the outer ring of each polygon).
 
-    Longitude/latitude (every coordinate within +-180, +-90 and the whole set within one degree)
-    are projected to metres around the collection's centre; other coordinates are taken as
-    metres.  East is +x, north is -z.  Each outline is cleaned by :func:`clean_ring`; a feature
+    Longitude/latitude (a legacy ``crs`` member naming a geographic CRS, or, without one, every
+    coordinate within +-180, +-90 and the whole set within one degree) are projected to the UTM
+    zone of the collection's centre, about a whole-metre origin near it; other coordinates are
+    taken as metres (see :func:`_project`).  East is +x, north is -z.  Each lot's ``site`` says
+    where its metres are on Earth.  Each outline is cleaned by :func:`clean_ring`; a feature
     that cannot be used is reported to ``warnings`` (one line naming it; an error when strict)
     and skipped.  A file with no usable footprint at all is an error.
     """
@@ -176,8 +180,13 @@ def read_geojson(path: Path, warnings: Warnings | None = None) -> list[Lot]:
             else:
                 rings.append((part_name, ring, properties, part_id))
 
+    crs = _legacy_crs(data, shown, warnings)
     lots = []
-    for name, ring, properties, ident in _project(rings):
+    projected, site = _project(rings, crs)
+    for name, ring, properties, ident in projected:
+        if isinstance(ring, FootprintError):
+            skip(name, str(ring))
+            continue
         try:
             outline, note = clean_ring(ring)
         except FootprintError as e:
@@ -190,6 +199,7 @@ def read_geojson(path: Path, warnings: Warnings | None = None) -> list[Lot]:
         lot = footprint([tuple(p) for p in outline], properties, name)
         lot.source = shown
         lot.feature_id = ident
+        lot.site = site
         lots.append(lot)
     if not lots:
         what = "no usable footprint" if polygons else "no Polygon features"
@@ -277,38 +287,118 @@ def _ring(polygon) -> np.ndarray:
     return ring
 
 
-def _project(items: list) -> list:
-    """Each (name, ring, properties) item with its ring in metres: longitude/latitude (see
-    read_geojson) projected about the centre of the collection's bounding box, which becomes
-    the origin; east is +x, north is -z.
+def _legacy_crs(data: dict, shown: str, warnings: Warnings):
+    """The pyproj CRS a file's legacy ``crs`` member names (GeoJSON 2008: ``{"type": "name",
+    "properties": {"name": "urn:ogc:def:crs:EPSG::3067"}}``, or ``{"type": "EPSG",
+    "properties": {"code": 3067}}``), or None without one.  RFC 7946 dropped the member, but
+    exports from GIS tools still carry it; one that names no CRS pyproj knows is ignored with a
+    warning, and the coordinates are read as if it were not there."""
+    member = data.get("crs") if isinstance(data, dict) else None
+    if member is None:
+        return None
+    props = member.get("properties") if isinstance(member, dict) else None
+    props = props if isinstance(props, dict) else {}
+    name, code = props.get("name"), props.get("code")
+    if name is None and isinstance(code, int) and not isinstance(code, bool) and 0 < code < 10**9:
+        name = f"EPSG:{code}"
+    from pyproj import CRS
+    from pyproj.exceptions import CRSError
 
-    The projection is equirectangular on the WGS84 ellipsoid: metres per degree are the radii of
-    curvature at the centre's latitude, so lengths and angles are right at the centre and off by
-    about 1 part in 10,000 a kilometre north or south of it.
+    if isinstance(name, str) and len(name) <= 200:
+        try:
+            crs = CRS.from_user_input(name)
+        except CRSError:
+            crs = None
+        if crs is not None and (crs.is_geographic or crs.is_projected):
+            return crs
+    warnings.warn(
+        Diagnostic(
+            shown,
+            0,
+            0,
+            f"its crs member {_shown(member)} names no known geographic or projected CRS; it "
+            "is ignored",
+            "without --strict the coordinates are read as if it were not there",
+        )
+    )
+    return None
+
+
+def utm_zone(longitude: float, latitude: float) -> str:
+    """The EPSG code of the WGS84 UTM zone a point lies in: EPSG:326NN north of the equator,
+    EPSG:327NN south (zone NN = 1..60, six degrees of longitude each from 180 W; the Norway and
+    Svalbard exceptions are not made)."""
+    zone = min(max(int(math.floor((longitude + 180.0) / 6.0)) + 1, 1), 60)
+    return f"EPSG:{(32600 if latitude >= 0 else 32700) + zone}"
+
+
+def _project(items: list, crs=None) -> tuple[list, dict | None]:
+    """Each (name, ring, properties, id) item with its ring in local metres (east +x, north -z),
+    and the site those metres are in: ``{"crs": "EPSG:NNNN", "origin": [E0, N0, 0.0]}`` (local
+    x = E - E0, local -z = N - N0), or None.
+
+    - Geographic coordinates (``crs`` geographic, or, with no ``crs``, longitude/latitude as
+      read_geojson tells them) are projected with pyproj to the UTM zone of the centre of their
+      bounding box (:func:`utm_zone`); the origin is the centre of the projected bounding box,
+      rounded to whole metres.  Lengths are true to the zone's scale (within 4 parts in 10,000
+      inside the zone), and the output files can name the CRS.
+    - A projected ``crs`` in metres keeps the coordinates as they are (origin 0, 0, 0) and is
+      recorded as the site; one in other units is taken as metres and not recorded.
+    - Otherwise the coordinates are metres as they are, with no site.
+
+    A ring that does not project to finite metres is a FootprintError in its place.
     """
     if not items:
-        return []
+        return [], None
     flat = np.concatenate([item[1] for item in items])
     lo, hi = flat.min(axis=0), flat.max(axis=0)
-    geographic = (
-        bool((np.abs(flat[:, 0]) <= 180).all() and (np.abs(flat[:, 1]) <= 90).all())
-        and hi[0] - lo[0] < 1.0
-        and hi[1] - lo[1] < 1.0
-    )
-    if geographic:
-        centre = (lo + hi) / 2.0
-        phi = math.radians(float(centre[1]))
-        w = math.sqrt(1.0 - _WGS84_E2 * math.sin(phi) ** 2)
-        per_degree = math.pi / 180.0
-        scale = np.array(
-            [
-                _WGS84_A / w * math.cos(phi) * per_degree,  # prime vertical radius N cos(phi)
-                -_WGS84_A * (1.0 - _WGS84_E2) / w**3 * per_degree,  # meridian radius M; north -z
-            ]
+    if crs is None:
+        geographic = (
+            bool((np.abs(flat[:, 0]) <= 180).all() and (np.abs(flat[:, 1]) <= 90).all())
+            and hi[0] - lo[0] < 1.0
+            and hi[1] - lo[1] < 1.0
         )
+        source = CRS84 if geographic else None
+    elif crs.is_geographic:
+        source = crs
     else:
-        centre, scale = np.zeros(2), np.array([1.0, -1.0])
-    return [(name, (ring - centre) * scale, *rest) for (name, ring, *rest) in items]
+        source = None
+    scale = np.array([1.0, -1.0])  # east +x, north -z
+    if source is None:
+        site = None
+        name = _crs_name(crs) if crs is not None else None
+        if name and crs.axis_info and crs.axis_info[0].unit_name == "metre":
+            site = {"crs": name, "origin": [0.0, 0.0, 0.0]}
+        return [(name, ring * scale, *rest) for (name, ring, *rest) in items], site
+
+    from pyproj import Transformer
+
+    centre = (lo + hi) / 2.0
+    target = utm_zone(float(centre[0]), float(centre[1]))
+    to_utm = Transformer.from_crs(source, target, always_xy=True)
+    with np.errstate(all="ignore"):
+        east, north = to_utm.transform(flat[:, 0], flat[:, 1], errcheck=False)
+    metres = np.column_stack([east, north])
+    finite = np.isfinite(metres).all(axis=1)
+    good = metres[finite] if finite.any() else np.zeros((1, 2))
+    origin = np.round((good.min(axis=0) + good.max(axis=0)) / 2.0)
+    out, at = [], 0
+    for name, ring, *rest in items:
+        part = metres[at : at + len(ring)]
+        at += len(ring)
+        if not np.isfinite(part).all():
+            out.append((name, FootprintError("its coordinates do not project to metres"), *rest))
+        else:
+            out.append((name, (part - origin) * scale, *rest))
+    site = {"crs": target, "origin": [float(origin[0]), float(origin[1]), 0.0]}
+    return out, site
+
+
+def _crs_name(crs) -> str | None:
+    """``AUTHORITY:CODE`` of a pyproj CRS (EPSG:3067); None for one no authority names, which
+    no output file could name either."""
+    authority = crs.to_authority()
+    return f"{authority[0]}:{authority[1]}" if authority else None
 
 
 # --------------------------------------------------------------------------------------------

@@ -14,13 +14,21 @@ import sys
 from pathlib import Path
 
 import numpy as np
+import pyproj
 import pytest
 from conftest import ROOT, SHARED
 from shapely.geometry import Polygon
 
 import bgr
 from bgr.interpreter.geometry.roofs import KINDS, MITRE_LIMIT
-from bgr.interpreter.lots import CLEAN_TOL, clean_ring, number_of, read_geojson
+from bgr.interpreter.lots import (
+    CLEAN_TOL,
+    clean_ring,
+    number_of,
+    read_geojson,
+    rectangle,
+    utm_zone,
+)
 from bgr.interpreter.terminals import world_vertices
 
 HELSINKI = SHARED / "data" / "footprints" / "helsinki_osm_buildings.geojson"
@@ -176,19 +184,128 @@ def test_features_are_named_by_index_and_id(tmp_path):
     assert "feature 3 (no id) skipped" in warning
 
 
-def test_longitude_latitude_is_projected_on_the_ellipsoid(tmp_path):
-    # 0.01 degree each way about 60 N: on the WGS84 ellipsoid a degree of longitude is 55,800 m
-    # there and a degree of latitude 111,412 m (a sphere of 6,371 km would say 55,597 and 111,195)
+def utm(points, zone: str) -> np.ndarray:
+    """(lon, lat) points in metres of a UTM zone, computed here with pyproj on its own."""
+    to_utm = pyproj.Transformer.from_crs("OGC:CRS84", zone, always_xy=True)
+    east, north = to_utm.transform(*np.asarray(points, dtype=float).T)
+    return np.column_stack([east, north])
+
+
+def same_corners(got: np.ndarray, expected: np.ndarray, tol: float) -> bool:
+    """The same points, in any order (a ring may start at another corner or run backwards)."""
+    gaps = np.linalg.norm(got[:, None, :] - expected[None, :, :], axis=2)
+    return len(got) == len(expected) and bool((gaps.min(axis=1) < tol).all())
+
+
+def test_longitude_latitude_is_projected_to_utm(tmp_path):
+    # 0.01 degree each way about 60 N, 24.95 E: UTM zone 35 north, whose central meridian is
+    # 27 E.  (Until the projection was UTM it was equirectangular about the file's centre: the
+    # corners moved by up to 9 m, as the UTM grid is turned 1.8 degrees from true north here.)
     ring = [[24.95, 59.995], [24.96, 59.995], [24.96, 60.005], [24.95, 60.005], [24.95, 59.995]]
     (lot,) = read_geojson(write(tmp_path, feature([ring])))
+    metres = utm(ring[:-1], "EPSG:32635")
+    origin = np.round((metres.min(axis=0) + metres.max(axis=0)) / 2)
+    assert lot.site == {"crs": "EPSG:32635", "origin": [*origin.tolist(), 0.0]}
+    # local = projected - origin; east is +x, north is -z
+    expected = (metres - origin) * [1.0, -1.0]
+    assert same_corners(world_ring(lot), expected, tol=1e-6)
+    # on the WGS84 ellipsoid a degree of longitude is 55,800 m there and one of latitude
+    # 111,412 m; UTM's scale is 0.9996 on the central meridian and about 0.99975 here
     width, _, depth = lot.shape.size
-    assert width == pytest.approx(558.00, abs=0.05)
-    assert depth == pytest.approx(1114.12, abs=0.05)
-    # about the collection's centre; east is +x, north is -z, the front the southern edge
-    ring = world_ring(lot)
-    assert ring.min(axis=0) == pytest.approx([-279.0, -557.06], abs=0.05)
-    assert ring.max(axis=0) == pytest.approx([279.0, 557.06], abs=0.05)
-    assert lot.shape.origin[2] == pytest.approx(557.06, abs=0.05)
+    assert width == pytest.approx(558.00, rel=3e-4)
+    assert depth == pytest.approx(1114.12, rel=3e-4)
+
+
+@pytest.mark.parametrize(
+    "lon, lat, zone",
+    [(24.94, 60.17, "EPSG:32635"), (151.21, -33.87, "EPSG:32756"), (-74.0, 40.7, "EPSG:32618"),
+     (-180.0, 0.0, "EPSG:32601"), (180.0, -1.0, "EPSG:32760"), (3.0, 0.0, "EPSG:32631")],
+)  # fmt: skip
+def test_the_utm_zone_is_the_centres(lon, lat, zone):
+    assert utm_zone(lon, lat) == zone
+
+
+def test_the_site_reaches_the_terminal_table(tmp_path):
+    ring = [[151.2, -33.87], [151.2002, -33.87], [151.2002, -33.8698], [151.2, -33.87]]
+    result = bgr.derive(BOX, lot=str(write(tmp_path, feature([ring]))))
+    site = result.terminals.site
+    assert site["crs"] == "EPSG:32756"  # Sydney: zone 56 south
+    metres = utm(ring[:-1], "EPSG:32756")
+    assert site["origin"] == [*np.round((metres.min(axis=0) + metres.max(axis=0)) / 2), 0.0]
+    assert all(float(v).is_integer() for v in site["origin"])
+    # metres without a crs member: no site
+    assert bgr.derive(BOX, lot=str(ROOT / "examples" / "block.geojson")).terminals.site is None
+    assert bgr.derive(BOX, lot=(10, 10)).terminals.site is None
+
+
+def with_crs(tmp_path: Path, crs: dict, coords: list) -> Path:
+    path = tmp_path / "crs.geojson"
+    doc = {"type": "FeatureCollection", "crs": crs, "features": [feature([coords])]}
+    path.write_text(json.dumps(doc))
+    return path
+
+
+def test_a_legacy_crs_member_in_metres_is_recorded_and_the_metres_kept(tmp_path):
+    # ETRS-TM35FIN (EPSG:3067), as Finnish open data is published
+    ring = [[385900, 6672300], [385920, 6672300], [385920, 6672315], [385900, 6672315]]
+    for crs in (
+        {"type": "name", "properties": {"name": "urn:ogc:def:crs:EPSG::3067"}},
+        {"type": "EPSG", "properties": {"code": 3067}},
+    ):
+        (lot,) = read_geojson(with_crs(tmp_path, crs, [*ring, ring[0]]))
+        assert lot.site == {"crs": "EPSG:3067", "origin": [0.0, 0.0, 0.0]}
+        assert same_corners(world_ring(lot), np.array(ring) * [1.0, -1.0], tol=1e-6)
+
+
+def test_a_legacy_geographic_crs_member_is_projected_even_over_a_degree(tmp_path):
+    # two degrees wide: without the member such a file would be taken as metres
+    ring = [[24.0, 60.0], [26.0, 60.0], [26.0, 60.5], [24.0, 60.0]]
+    crs = {"type": "name", "properties": {"name": "urn:ogc:def:crs:OGC:1.3:CRS84"}}
+    (lot,) = read_geojson(with_crs(tmp_path, crs, ring))
+    assert lot.site["crs"] == "EPSG:32635"
+    metres = utm(ring[:-1], "EPSG:32635")
+    origin = np.array(lot.site["origin"][:2])
+    assert same_corners(world_ring(lot), (metres - origin) * [1.0, -1.0], tol=1e-6)
+    (plain,) = read_geojson(write(tmp_path, feature([ring])))
+    assert plain.site is None and plain.shape.size[0] == pytest.approx(2.0)
+
+
+def test_an_unknown_crs_member_is_ignored_with_a_warning(tmp_path):
+    from bgr.grammar.errors import Warnings
+
+    ring = [[0, 0], [10, 0], [10, 8], [0, 8], [0, 0]]
+    path = with_crs(tmp_path, {"type": "name", "properties": {"name": "EPSG:999999"}}, ring)
+    warnings = Warnings()
+    (lot,) = read_geojson(path, warnings)
+    assert lot.site is None and lot.shape.size == pytest.approx((10.0, 0.0, 8.0))
+    (warning,) = messages(warnings.items)
+    assert "names no known geographic or projected CRS" in warning
+    with pytest.raises(bgr.BgrError, match="no known"):
+        bgr.derive(BOX, lot=str(path), strict=True)
+
+
+def test_a_ring_that_does_not_project_is_skipped(tmp_path):
+    # the member says degrees, the numbers are metres: the far one cannot be projected
+    crs = {"type": "name", "properties": {"name": "EPSG:4326"}}
+    good = [[24.94, 60.17], [24.9402, 60.17], [24.9402, 60.1702], [24.94, 60.17]]
+    path = tmp_path / "mixed.geojson"
+    doc = {
+        "type": "FeatureCollection",
+        "crs": crs,
+        "features": [feature([good], ident=1), feature([square(3e5, 6.6e6)], ident=2)],
+    }
+    path.write_text(json.dumps(doc))
+    result = bgr.derive(BOX, lot=str(path))
+    assert len(result.terminals.lots) == 1
+    (warning,) = messages(result.warnings)
+    assert "feature 1 (id 2) skipped: its coordinates do not project to metres" in warning
+
+
+def test_lots_of_different_sites_cannot_share_a_run(tmp_path):
+    ring = [[24.94, 60.17], [24.9402, 60.17], [24.9402, 60.1702], [24.94, 60.17]]
+    (geo,) = read_geojson(write(tmp_path, feature([ring])))
+    with pytest.raises(bgr.BgrError, match="different coordinate systems"):
+        bgr.derive(BOX, lot=[geo, rectangle(10, 10)])
 
 
 # ---------------------------------------------------------------------------------------------

@@ -63,9 +63,31 @@ LONLAT = {
 }
 
 
+# legacy crs members (GeoJSON 2008), which name the CRS the coordinates are in
+LEGACY_CRS = [
+    dict(LONLAT, crs={"type": "name", "properties": {"name": "urn:ogc:def:crs:OGC:1.3:CRS84"}}),
+    {
+        "type": "FeatureCollection",
+        "crs": {"type": "EPSG", "properties": {"code": 3067}},
+        "features": [
+            {
+                "type": "Feature",
+                "properties": {"height": 7},
+                "geometry": {
+                    "type": "Polygon",
+                    "coordinates": [
+                        [[385900, 6672300], [385920, 6672300], [385920, 6672315], [385900, 6672300]]
+                    ],
+                },
+            }
+        ],
+    },
+]
+
+
 def seeds() -> list:
     files = sorted(ROOT.glob("examples/*.geojson")) + sorted(ROOT.glob("tests/data/**/*.geojson"))
-    return [json.loads(p.read_text(encoding="utf-8")) for p in files] + [LONLAT]
+    return [json.loads(p.read_text(encoding="utf-8")) for p in files] + [LONLAT, *LEGACY_CRS]
 
 
 SEEDS = seeds()

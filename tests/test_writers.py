@@ -528,10 +528,8 @@ def test_unknown_extension_is_a_bgr_error(tmp_path):
     t = small_table()
     with pytest.raises(BgrError) as err:
         write(t, tmp_path / "out.fbx", seed=0, attrs={})
-    for ext in (".glb", ".gltf", ".obj", ".ply", ".stl", ".json"):
+    for ext in (".glb", ".gltf", ".obj", ".ply", ".stl", ".json", ".city.json", ".city.jsonl"):
         assert ext in str(err.value)
-    with pytest.raises(BgrError, match="CityJSON"):
-        write(t, tmp_path / "out.city.json", seed=0, attrs={})
     with pytest.raises(BgrError, match="unknown output format"):
         write(t, tmp_path / "out.glb", seed=0, attrs={}, fmt="fbx")
     with pytest.raises(BgrError, match="has no extension"):
