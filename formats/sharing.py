@@ -14,12 +14,16 @@ _MIX = np.uint64(0x9E3779B97F4A7C15)  # odd 64-bit constants of the splitmix64 g
 _FOLD = np.uint64(0xBF58476D1CE4E5B9)
 
 
-def _numbered(order: np.ndarray, new: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def _numbered(
+    order: np.ndarray, new: np.ndarray, rows_ascend: bool
+) -> tuple[np.ndarray, np.ndarray]:
     """Numbers from a sort: ``order`` lists the rows with equal rows adjacent, ``new`` (over
     ``order``) marks where a run of equal rows starts.  The result does not depend on the order
-    of the rows inside a run, so any sort will do."""
+    of the rows inside a run, so any sort will do; ``rows_ascend`` says that each run lists its
+    rows in increasing order (its first is then its earliest)."""
     starts = np.flatnonzero(new)
-    first = np.minimum.reduceat(order, starts)  # each run's earliest row
+    # each run's earliest row
+    first = order[starts] if rows_ascend else np.minimum.reduceat(order, starts)
     is_first = np.zeros(len(order), dtype=bool)
     is_first[first] = True
     rank = np.cumsum(is_first) - 1  # a first row's number: how many firsts come before it
@@ -31,14 +35,24 @@ def _numbered(order: np.ndarray, new: np.ndarray) -> tuple[np.ndarray, np.ndarra
 def number_keys(key: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """``(ids, firsts)`` for a 1-D integer key: ``ids[i]`` numbers the distinct keys in order of
     first occurrence, ``firsts[j]`` is the row where key number ``j`` first occurs."""
-    if len(key) == 0:
+    n = len(key)
+    if n == 0:
         return np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64)
-    order = np.argsort(key)
-    ordered = key[order]
+    low = key.min()
+    offset = key - low  # in the key's own type: no overflow
+    bits = max(1, (n - 1).bit_length())
+    packs = int(offset.max()) < 2 ** (63 - bits)
+    if packs:  # key and row in one int64: sorted 3x faster, rows ascending among equal keys
+        packed = np.sort((offset.astype(np.int64) << bits) | np.arange(n))
+        order = packed & ((1 << bits) - 1)
+        ordered = packed >> bits
+    else:
+        order = np.argsort(key)
+        ordered = key[order]
     new = np.empty(len(key), dtype=bool)
     new[0] = True
     np.not_equal(ordered[1:], ordered[:-1], out=new[1:])
-    return _numbered(order, new)
+    return _numbered(order, new, rows_ascend=packs)
 
 
 def _hash(columns: list[np.ndarray]) -> np.ndarray:
@@ -82,4 +96,4 @@ def number_rows(columns: list[np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
     for c in cols:
         ordered = c[order]
         new[1:] |= ordered[1:] != ordered[:-1]
-    return _numbered(order, new)
+    return _numbered(order, new, rows_ascend=True)  # lexsort is stable
