@@ -110,17 +110,22 @@ class _Blocks:
     def __init__(self, n: int, fmt: Callable[[int, int], bytes]) -> None:
         self.n, self.fmt = n, fmt
         self.lo = self.hi = 0
-        self.text, self.starts = b"", np.zeros(1, dtype=np.int64)
+        self.text = b""
+        self.starts: np.ndarray | None = None  # where each line of the block starts, once asked
 
     def write(self, stream: BinaryIO, lo: int, hi: int) -> None:
         while lo < hi:
             if not self.lo <= lo < self.hi:
                 self.lo, self.hi = lo, min(self.n, lo + LINES_PER_BLOCK)
-                self.text = self.fmt(self.lo, self.hi)
-                self.starts = line_starts(self.text)
+                self.text, self.starts = self.fmt(self.lo, self.hi), None
             end = min(hi, self.hi)
-            view = memoryview(self.text)[self.starts[lo - self.lo] : self.starts[end - self.lo]]
-            stream.write(view)
+            if lo == self.lo and end == self.hi:
+                stream.write(self.text)
+            else:
+                if self.starts is None:
+                    self.starts = line_starts(self.text)
+                first, last = self.starts[lo - self.lo], self.starts[end - self.lo]
+                stream.write(memoryview(self.text)[first:last])
             lo = end
 
 

@@ -67,7 +67,7 @@ def write_ply(table: TerminalTable, stream: BinaryIO, *, seed: int, attrs: dict)
     out = np.empty(len(first), dtype=VERTEX)
     at = baked.vertices[baked.faces.reshape(-1)[first]]
     out["x"], out["y"], out["z"] = at[:, 0], at[:, 1], at[:, 2]
-    n = normals[face_of_first].astype(np.float32)
+    n = normals[face_of_first].astype(np.float32) + np.float32(0.0)  # -0.0 becomes 0.0
     out["nx"], out["ny"], out["nz"] = n[:, 0], n[:, 1], n[:, 2]
     rgb = np.repeat(srgb8(table), nf, axis=0)[face_of_first]
     out["red"], out["green"], out["blue"] = rgb[:, 0], rgb[:, 1], rgb[:, 2]
