@@ -38,7 +38,7 @@ from .meshes import bake, unit_normals
 from .sharing import number_rows
 from .text import decimal, gather, integer, left_aligned, line_starts, quantize, render, word
 
-LINES_PER_BLOCK = 1 << 19  # lines formatted at once: bounds the memory of a large file
+LINES_PER_BLOCK = 1 << 17  # lines formatted at once: bounds the memory of a large file
 
 
 def obj_name(text: str) -> str:
@@ -129,6 +129,19 @@ class _Blocks:
             lo = end
 
 
+def runs(keys: np.ndarray, fstart: np.ndarray) -> list[tuple[int, int, int, int, int]]:
+    """``(object, label, material, first face, end face)`` of each run of rows with equal
+    ``keys`` (3, n) whose rows have faces, from the rows' face offsets ``fstart`` (n + 1,)."""
+    n = keys.shape[1]
+    if n == 0:
+        return []
+    cuts = np.flatnonzero((keys[:, 1:] != keys[:, :-1]).any(axis=0)) + 1
+    first = np.concatenate([[0], cuts]).astype(np.int64)
+    end = np.concatenate([cuts, [n]]).astype(np.int64)
+    out = zip(*keys[:, first].tolist(), fstart[first].tolist(), fstart[end].tolist(), strict=True)
+    return [run for run in out if run[4] > run[3]]
+
+
 def write_obj(
     table: TerminalTable, stream: BinaryIO, mtl: BinaryIO, *, mtl_name: str, seed: int, attrs: dict
 ) -> None:
@@ -137,77 +150,64 @@ def write_obj(
     mats = materials_of(table)
     lot_of, objects = lot_names(table)
     label_of, labels = codes(list(table.label))
-    group_names = unique_names(labels)
-    rows = np.lexsort((np.arange(len(table)), mats.index, label_of, lot_of))
+    rows = np.lexsort((np.arange(len(table)), mats.index, label_of, lot_of))  # the file's order
     baked = bake(table, rows)
-    nf = np.diff(baked.fstart)
 
     # vertices: one per distinct (object, written position) that a face uses, in file order
     used = np.zeros(len(baked.vertices), dtype=bool)
     used[baked.faces] = True
     used_at = np.flatnonzero(used)
-    vq = quantize(baked.vertices[used_at])
+    vq = quantize(np.take(baked.vertices, used_at, axis=0))
     vlot = np.repeat(lot_of[rows], np.diff(baked.vstart))[used_at]
     ids, vfirst = number_rows([vlot, vq[:, 0], vq[:, 1], vq[:, 2]])
     vid = np.zeros(len(baked.vertices), dtype=np.int64)
     vid[used_at] = ids
     vpos = vq[vfirst]
-    # normals: one per distinct written face normal, for the whole file
-    nq = quantize(unit_normals(baked.vertices[baked.faces]))
-    nid, nfirst = number_rows([nq[:, 0], nq[:, 1], nq[:, 2]])
+    v_end = np.searchsorted(vlot[vfirst], np.arange(len(objects)), side="right")
     corners = vid[baked.faces]
-
-    def v_lines(lo: int, hi: int) -> bytes:
-        return _point_lines(b"v ", vpos[lo:hi])
-
-    def vn_lines(lo: int, hi: int) -> bytes:
-        return _point_lines(b"vn ", nq[nfirst[lo:hi]])
-
+    # normals: one per distinct written face normal, for the whole file
+    nq = quantize(unit_normals(np.take(baked.vertices, baked.faces, axis=0)))
+    nid, nfirst = number_rows([nq[:, 0], nq[:, 1], nq[:, 2]])
     normal_text = left_aligned(integer(np.arange(1, len(nfirst) + 1), b"//"))
 
     def f_lines(lo: int, hi: int) -> bytes:
         c = corners[lo:hi]
-        first_v = int(c.min(initial=0))
-        v_text = integer(np.arange(first_v + 1, int(c.max(initial=0)) + 2))
+        first = int(c.min(initial=0))  # the vertex numbers of a block, formatted once each
+        v_text = integer(np.arange(first + 1, int(c.max(initial=0)) + 2))
         vn = gather(normal_text, nid[lo:hi])
         wv, wn = v_text.shape[1], vn.shape[1]
         grid = np.empty((hi - lo, 2 + 3 * (wv + wn)), dtype=np.uint64)
         grid[:, 0] = word(b"f")
         for k in range(3):
             at = 1 + k * (wv + wn)
-            grid[:, at : at + wv] = gather(v_text, c[:, k] - first_v)
+            grid[:, at : at + wv] = gather(v_text, c[:, k] - first)
             grid[:, at + wv : at + wv + wn] = vn
         grid[:, -1] = word(b"\n")
         return render(grid)
 
-    out = stream
-    out.write(f"# bgr seed {seed}\nmtllib {mtl_name}\n".encode())
-    _Blocks(len(nfirst), vn_lines).write(out, 0, len(nfirst))
-    v_blocks, f_blocks = _Blocks(len(vpos), v_lines), _Blocks(len(corners), f_lines)
-
-    # runs of faces with one (object, label, material), in file order
-    face_row = np.repeat(rows, nf)
-    keys = np.stack([lot_of[face_row], label_of[face_row], mats.index[face_row]])
-    cuts = np.flatnonzero((keys[:, 1:] != keys[:, :-1]).any(axis=0)) + 1
-    starts = np.concatenate([[0], cuts]).astype(np.int64)
-    ends = np.concatenate([cuts, [len(face_row)]]).astype(np.int64)
-    v_end = np.searchsorted(vlot[vfirst], np.arange(len(objects)), side="right")
-    names = obj_names(mats)
+    stream.write(f"# bgr seed {seed}\nmtllib {mtl_name}\n".encode())
+    _Blocks(len(nfirst), lambda lo, hi: _point_lines(b"vn ", nq[nfirst[lo:hi]])).write(
+        stream, 0, len(nfirst)
+    )
+    v_lines = _Blocks(len(vpos), lambda lo, hi: _point_lines(b"v ", vpos[lo:hi]))
+    f_blocks = _Blocks(len(corners), f_lines)
+    groups, materials = unique_names(labels), obj_names(mats)
+    keys = np.stack([lot_of[rows], label_of[rows], mats.index[rows]])
     current = (-1, -1)
-    for lo, hi in zip(starts.tolist(), ends.tolist(), strict=True):
-        if hi == lo:
-            continue
-        obj, label, mat = (int(k) for k in keys[:, lo])
+    for obj, label, mat, lo, hi in runs(keys, baked.fstart):
         if obj != current[0]:
-            out.write(f"o {objects[obj]}\n".encode())
-            v_lo = int(v_end[obj - 1]) if obj else 0
-            v_blocks.write(out, v_lo, int(v_end[obj]))
+            stream.write(f"o {objects[obj]}\n".encode())
+            v_lines.write(stream, int(v_end[obj - 1]) if obj else 0, int(v_end[obj]))
         if (obj, label) != current:
-            out.write(f"g {group_names[label]}\n".encode())
+            stream.write(f"g {groups[label]}\n".encode())
         current = (obj, label)
-        out.write(f"usemtl {names[mat]}\n".encode())
-        f_blocks.write(out, lo, hi)
+        stream.write(f"usemtl {materials[mat]}\n".encode())
+        f_blocks.write(stream, lo, hi)
+    mtl.write(mtl_text(mats, materials))
 
+
+def mtl_text(mats: Materials, names: list[str]) -> bytes:
+    """The .mtl: each material's sRGB colour as ``Kd``, no ambient or specular light."""
     lines = ["# bgr materials"]
     for k, name in enumerate(names):
         r, g, b = (c / 255.0 for c in mats.rgb8[k])
@@ -220,4 +220,4 @@ def write_obj(
             "illum 1",
             "",
         ]
-    mtl.write("\n".join(lines).encode("utf-8"))
+    return "\n".join(lines).encode("utf-8")
