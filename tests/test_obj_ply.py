@@ -328,3 +328,19 @@ def test_derived_twice_written_twice_identical(tmp_path, ext):
         bgr.derive(grammar, seed=5, lot=lot).save(tmp_path / f"{name}.{ext}")
     a, b = (tmp_path / f"a.{ext}").read_bytes(), (tmp_path / f"b.{ext}").read_bytes()
     assert a.replace(b"a.mtl", b"") == b.replace(b"b.mtl", b"")
+
+
+def test_the_obj_example_in_the_docs_is_what_bgr_writes(tmp_path):
+    text = (ROOT / "docs" / "cli.md").read_text()
+    start = text.index("$ cat box.obj\n") + len("$ cat box.obj\n")
+    shown = text[start : text.index("```", start)]
+    grammar = (
+        "attr height = 6\n\n"
+        "Lot --> extrude(height) comp(f) { top: Roof | front: Door | bottom: NIL }\n"
+        'Roof --> roof(flat) color("#7a3b2e")\n'
+        'Door --> s(1.2, 2.2, 0) center(x) color("#3b4a5a") label("Entrance")\n'
+    )
+    assert grammar in text  # the box.bgr the docs show
+    bgr.derive(grammar, lot=(8, 6), attrs={"height": 3}).save(tmp_path / "box.obj")
+    assert (tmp_path / "box.obj").read_text() == shown
+    assert len(trimesh.load(tmp_path / "box.obj", force="mesh").faces) == 4
