@@ -71,11 +71,32 @@ def number_rows(columns: list[np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
     """:func:`number_keys` for rows of several integer columns (equal rows: equal in every
     column).
 
+    A row equal to the one before it (the two triangles of a quad have one normal) takes its
+    number without being sorted: only the first row of each such run is.
+    """
+    cols = [np.asarray(c, dtype=np.int64) for c in columns]
+    n = len(cols[0])
+    if n > 1:
+        repeats = cols[-1][1:] == cols[-1][:-1]
+        for c in cols[-2::-1]:
+            if not repeats.any():
+                break
+            repeats &= c[1:] == c[:-1]
+        if repeats.any():
+            head = np.concatenate([[True], ~repeats])
+            at = np.flatnonzero(head)
+            ids, firsts = _number_distinct([c[at] for c in cols])
+            return ids[np.cumsum(head) - 1], at[firsts]
+    return _number_distinct(cols)
+
+
+def _number_distinct(cols: list[np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`number_rows` by sorting every row.
+
     Columns whose ranges multiply to less than 2**63 are packed into one exact key.  Otherwise
     rows are numbered by a 64-bit hash, checked against the rows themselves; if two different
     rows ever shared a hash, a sort on all columns numbers them instead.
     """
-    cols = [np.asarray(c, dtype=np.int64) for c in columns]
     n = len(cols[0])
     if n == 0:
         return number_keys(np.zeros(0, dtype=np.int64))

@@ -78,11 +78,19 @@ def first_use(rows: list[tuple]) -> tuple[list[int], list[int]]:
     return ids, firsts
 
 
+@pytest.mark.parametrize("layout", ["shuffled", "runs", "distinct"])
 @pytest.mark.parametrize("scale", [1, 10**14])
-def test_rows_are_numbered_by_first_use(scale, monkeypatch):
+def test_rows_are_numbered_by_first_use(scale, layout, monkeypatch):
+    """Packed keys (small numbers) and hashed ones (large), rows repeated at random, in runs
+    (as a quad's two normals) or never."""
     rng = np.random.default_rng(4)
-    distinct = rng.integers(-5, 5, (300, 3)) * scale
-    rows = distinct[rng.integers(0, 300, 5000)]
+    distinct = np.unique(rng.integers(-5, 5, (300, 3)), axis=0) * scale
+    if layout == "distinct":
+        rows = distinct[rng.permutation(len(distinct))]
+    else:
+        rows = distinct[rng.integers(0, len(distinct), 5000)]
+        if layout == "runs":
+            rows = np.repeat(rows, rng.integers(1, 4, len(rows)), axis=0)
     ids, firsts = first_use([tuple(r) for r in rows.tolist()])
     columns = [rows[:, 0], rows[:, 1], rows[:, 2]]
     got = number_rows(columns)
@@ -92,6 +100,7 @@ def test_rows_are_numbered_by_first_use(scale, monkeypatch):
     got = number_rows(columns)
     assert got[0].tolist() == ids and got[1].tolist() == firsts
     assert [a.tolist() for a in number_rows([np.zeros(0, dtype=np.int64)])] == [[], []]
+    assert [a.tolist() for a in number_rows([np.array([7])])] == [[0], [0]]
 
 
 def test_quantize_is_what_decimal_prints():
