@@ -1,4 +1,4 @@
-"""Benchmark: write one ~1M-triangle terminal table as .glb, .obj, .ply, .stl and .json.
+"""Benchmark: write one ~1M-triangle terminal table in every format bgr writes.
 
     python bench/writers.py [--triangles 1000000] [--repeat 5] [--out DIR]
 
@@ -9,7 +9,8 @@ with ``--instancing`` boxes are instanced (EXT_mesh_gpu_instancing) and quads ba
 repeat writes every format once, in turn, so that a busy machine slows them alike; the script
 prints the median and best wall time of ``bgr.formats.write`` (everything from the table to the
 renamed file), the median CPU time of the process, the file sizes, and each format's median time
-over the (default) GLB's.  Target (issue 11): OBJ within 2x of the GLB.
+over the (default) GLB's; then .city.json and .city.jsonl (:func:`cityjson_rows`, timed on
+their own).  Target (issue 11): OBJ within 2x of the GLB.
 """
 
 from __future__ import annotations
