@@ -131,19 +131,35 @@ def bake(
     for group in _shape_groups(nv, nf):
         V, F = int(nv[group[0]]), int(nf[group[0]])
         r, m = rows[group], mesh[group]
+        # a group of consecutive rows is computed straight into its slice of the output
+        run = int(group[-1]) - int(group[0]) + 1 == len(group)
         if V:
-            local = pool.vertices[pool.voff[m][:, None] + np.arange(V)] * table.size[r][:, None, :]
+            local = pool.vertices[pool.voff[m][:, None] + np.arange(V)]
+            local *= table.size[r][:, None, :]
             axes = table.axes[r]
-            world = table.origin[r][:, None, :] + local[:, :, 0:1] * axes[:, None, 0, :]
-            world += local[:, :, 1:2] * axes[:, None, 1, :]
-            world += local[:, :, 2:3] * axes[:, None, 2, :]
-            vertices[vstart[group][:, None] + np.arange(V)] = world
+            if run:
+                lo, hi = vstart[group[0]], vstart[group[-1] + 1]
+                world = vertices[lo:hi].reshape(len(group), V, 3)
+            else:
+                world = np.empty((len(group), V, 3))
+            # origin + x a0 + y a1 + z a2, added in that order
+            np.multiply(local[:, :, 0:1], axes[:, None, 0, :], out=world)
+            world += table.origin[r][:, None, :]
+            term = np.empty_like(world)
+            for k in (1, 2):
+                np.multiply(local[:, :, k : k + 1], axes[:, None, k, :], out=term)
+                world += term
+            if not run:
+                vertices[vstart[group][:, None] + np.arange(V)] = world
         if F:
             tri = pool.faces[pool.foff[m][:, None] + np.arange(F)] + vstart[group][:, None, None]
             flipped = flip[group]
             if flipped.any():
                 tri[flipped] = tri[flipped][:, :, ::-1]
-            faces[fstart[group][:, None] + np.arange(F)] = tri
+            if run:
+                faces[fstart[group[0]] : fstart[group[-1] + 1]] = tri.reshape(-1, 3)
+            else:
+                faces[fstart[group][:, None] + np.arange(F)] = tri
     return Baked(vertices, faces, vstart, fstart)
 
 
