@@ -197,21 +197,28 @@ def build_parser() -> argparse.ArgumentParser:
 
     infer = commands.add_parser(
         "infer",
-        help="write a grammar from data (face schemas today)",
-        description="Infer a .bgr grammar from data. --kind schema: "
+        help="write a grammar from data: face schemas, or a whole city",
+        description="Infer a .bgr grammar from data. --kind city (the default for .obj, .ply, "
+        ".glb, .gltf and CityJSON inputs): city-scale proceduralization of a 3D city, a "
+        "grammar of component types whose meshes go in an assets folder beside it "
+        "(docs/inverse-city.md). --kind schema (the default for other .json and .bgr): "
         "Build-by-Number face, floor and model schemas of a labelled, subdivided "
         "building: a terminal list (bgr derive -o x.json), a captured-model JSON "
-        "(docs/inverse-schema.md) or a .bgr (derived first). The grammar, derived "
+        "(docs/inverse-schema.md) or a .bgr (derived first); the grammar, derived "
         "with --lot, styles a new mass.",
     )
     infer.add_argument(
-        "input", metavar="INPUT", help="terminal list .json, captured-model .json, or .bgr"
+        "input",
+        metavar="INPUT",
+        help="a city (.obj, .ply, .glb, .gltf, .city.json, .city.jsonl), or a terminal list "
+        ".json, captured-model .json or .bgr for --kind schema",
     )
     infer.add_argument(
         "--kind",
         choices=["schema", "city", "boxes", "style", "image"],
-        default="schema",
-        help="what to infer (default schema; the others are not written yet)",
+        default=None,
+        help="what to infer (default: city for 3D models and CityJSON, schema otherwise; "
+        "boxes, style and image are not written yet)",
     )
     infer.add_argument(
         "-o", "--output", metavar="OUT.bgr", help="write here (default: standard output)"
@@ -238,6 +245,69 @@ def build_parser() -> argparse.ArgumentParser:
         default=[],
         metavar="DIR",
         help=ALLOW_PATH_HELP,
+    )
+
+    city = infer.add_argument_group("--kind city")
+    city.add_argument(
+        "--assets",
+        metavar="DIR",
+        help="folder for the component meshes (default: OUT.assets beside -o OUT.bgr, or "
+        "./city.assets when the grammar goes to standard output)",
+    )
+    city.add_argument(
+        "--up",
+        choices=["auto", "y", "z"],
+        default="auto",
+        help="the input's up axis (default auto: z for CityJSON, y for glTF, the flattest axis "
+        "of an OBJ or PLY city)",
+    )
+    which = city.add_mutually_exclusive_group()
+    which.add_argument(
+        "--level",
+        type=_whole,
+        help="de-instancing level: 0 (default) is lossless, each level up about halves the "
+        "component types",
+    )
+    which.add_argument(
+        "--threshold",
+        type=float,
+        metavar="T_D",
+        help="the coarsest level whose components are all within T_D of their type's "
+        "representative (feature units: metres, tens of degrees, outline vertices)",
+    )
+    city.add_argument(
+        "--weights",
+        metavar="FEATURE=W,...",
+        default="",
+        help="feature weights of the dissimilarity, e.g. 'height=3,rotation=0' (features: "
+        "front-shape, side-shape, width, height, depth, rotation, roof-slope, intensity)",
+    )
+    city.add_argument(
+        "--w-mu", type=float, default=1.0, help="weight of closeness in the distance (eq. 11)"
+    )
+    city.add_argument(
+        "--w-sigma", type=float, default=1.0, help="weight of consistency in the distance"
+    )
+    city.add_argument(
+        "--tau",
+        type=float,
+        metavar="METRES",
+        help="neighbour distance between building midpoints (default: 1.5 x the median "
+        "distance to the nearest building)",
+    )
+    city.add_argument(
+        "--representative",
+        choices=["mean", "fewest"],
+        default="mean",
+        help="a type's mesh: the member closest to the mean (default) or with fewest triangles",
+    )
+    city.add_argument(
+        "--stats",
+        action="store_true",
+        help="print, for every level, the counts, sizes and geometric error to standard error",
+    )
+    city.add_argument(
+        "--no-progress", action="store_true", help="no progress bars on standard error"
     )
 
     fmt = commands.add_parser(
@@ -499,9 +569,15 @@ def cmd_derive(args) -> int:
 
 
 def cmd_infer(args) -> int:
-    if args.kind != "schema":
+    kind = args.kind or _infer_kind(args.input)
+    if kind == "city":
+        from .inverse.city.command import run
+
+        return run(args)
+    if kind != "schema":
         print(
-            f"bgr infer: --kind {args.kind} is not written yet; --kind schema is", file=sys.stderr
+            f"bgr infer: --kind {kind} is not written yet; --kind schema and city are",
+            file=sys.stderr,
         )
         return EXIT_INPUT
     fixed: dict[str, bool] = {}
@@ -525,6 +601,20 @@ def cmd_infer(args) -> int:
         write_atomic(Path(args.output), text)
         print(f"{args.output}: {text.count(chr(10))} lines", file=sys.stderr)
     return EXIT_OK
+
+
+def _infer_kind(path: str) -> str:
+    """city for 3D models and CityJSON, schema for everything else (.bgr, other .json)."""
+    lower = path.lower()
+    if lower.endswith((".obj", ".ply", ".glb", ".gltf", ".city.json", ".city.jsonl", ".jsonl")):
+        return "city"
+    if lower.endswith(".json"):
+        with contextlib.suppress(OSError):
+            with open(path, "rb") as f:
+                head = f.read(4096)
+            if re.search(rb'"type"\s*:\s*"CityJSON"', head):
+                return "city"
+    return "schema"
 
 
 def _parse_size(text: str) -> tuple[int, int] | None:

@@ -284,6 +284,12 @@ class Formatter:
             head = ") -->"
         body = rule.body
         if isinstance(body, n.Sequence):
+            if self.one_push_a_line(head, body):
+                out.write(head)
+                for step in body.steps:
+                    out.start(step.pos.line or rule.pos.line, 1)
+                    self.steps([step], out)
+                return
             out.write(head + " ")
             self.steps(body.steps, out)
             return
@@ -316,6 +322,16 @@ class Formatter:
             out.start(alt.pos.line or rule.pos.line, 1)
             out.write(("| " if i else "") + h)
             self.steps(alt.body.steps, out)
+
+    def one_push_a_line(self, head: str, body: n.Sequence) -> bool:
+        """A rule that only places children (``[ ... A ] [ ... B ] ...``, as the city grammars
+        of bgr infer write) and is too long for a line gets one placement per line."""
+        steps = body.steps
+        if len(steps) < 2 or not all(isinstance(s, n.Push) for s in steps):
+            return False
+        if self.has_comment_inside(body.pos) or self.has_comment_on_line(body.pos.end_line):
+            return False  # comments keep the rule on one line, so that fmt(fmt(x)) == fmt(x)
+        return len(head) + 1 + len(self.inline_steps(steps)) > self.width
 
     def alt_head(self, alt) -> str:
         if isinstance(alt, n.Choice):

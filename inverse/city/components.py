@@ -1,0 +1,156 @@
+"""Components: a box about the vertical axis for each slab, its mesh in the box's frame, a key
+that equal meshes share, and the feature vector that clusters components into types.
+
+The box (paper, section IV.B) is the minimum-area rectangle of the slab's vertices seen from
+above, extruded from the slab's bottom to its top.  A rectangle has four frames (it looks the same
+turned by 90 degrees); the one chosen is the one whose mesh, in that frame, has the smallest key,
+so that two copies of a component turned by any multiple of 90 degrees get the same frame
+relative to their geometry, and the same key.
+"""
+
+from __future__ import annotations
+
+import hashlib
+from dataclasses import dataclass
+
+import numpy as np
+import shapely
+from trimesh.bounds import oriented_bounds_2D
+
+from .cuts import Slab
+
+KEY_GRID = 1e-4  # metres: meshes equal on this grid share a key (level 0 is exact within 1 mm)
+
+# the feature vector (paper, section IV.C), in units where 1 is a noticeable difference
+FEATURES = (
+    "front shape",  # vertices of the Douglas-Peucker outline seen from the front
+    "side shape",  # ... and from the side
+    "width",  # metres
+    "height",
+    "depth",
+    "rotation",  # tens of degrees, of the box about the vertical, in [0, 90)
+    "roof slope",  # tens of degrees: area-weighted slope of the upward faces that are not flat
+    "intensity",  # tenths of grey (0..10) of the faces' colours, where the input has colours
+)
+
+
+@dataclass
+class Component:
+    """One slab of one building, in the frame of its box."""
+
+    building: int  # index of the object it was cut from
+    frame: np.ndarray  # (4, 4): box frame -> bgr world (columns: x, y up, z, origin)
+    size: np.ndarray  # (3,) box size along the frame's x, y, z
+    vertices: np.ndarray  # (V, 3) in the box frame: within [0, size]
+    faces: np.ndarray  # (F, 3)
+    colors: np.ndarray | None  # (F, 4) uint8 or None
+    key: str  # equal for meshes equal on KEY_GRID (in their chosen frame)
+    angle: float  # degrees, the rectangle's rotation about the vertical, in [0, 90)
+
+
+def _turn(angle_deg: float) -> np.ndarray:
+    """The frame axes for a box turned by ``angle`` about bgr's y (up): x, y, z as columns."""
+    a = np.radians(angle_deg)
+    x = np.array([np.cos(a), 0.0, -np.sin(a)])
+    y = np.array([0.0, 1.0, 0.0])
+    return np.column_stack([x, y, np.cross(x, y)])
+
+
+def mesh_key(vertices: np.ndarray, faces: np.ndarray) -> str:
+    """A digest of a mesh that does not depend on vertex or triangle order (nor on where each
+    triangle's corner list starts), only on the triangles' corners on the KEY_GRID."""
+    grid = np.rint(vertices / KEY_GRID).astype(np.int64)
+    tri = grid[faces]  # (F, 3, 3)
+    # start each triangle at its smallest corner, keeping the winding
+    order = np.argmin(_corner_rank(tri), axis=1)
+    turn = (np.arange(3)[None, :] + order[:, None]) % 3
+    rolled = np.take_along_axis(tri, turn[:, :, None], axis=1)
+    flat = rolled.reshape(len(tri), 9)
+    flat = flat[np.lexsort(flat.T[::-1])]
+    return hashlib.sha1(flat.tobytes()).hexdigest()
+
+
+def _corner_rank(tri: np.ndarray) -> np.ndarray:
+    """(F, 3) rank of each corner among all corners (lexicographic on x, y, z)."""
+    corners = tri.reshape(-1, 3)
+    rank = np.empty(len(corners), dtype=np.int64)
+    rank[np.lexsort(corners.T[::-1])] = np.arange(len(corners))
+    return rank.reshape(-1, 3)
+
+
+def fit(slab: Slab, building: int, colors: np.ndarray | None) -> Component:
+    """The component of a slab: its box, its mesh in the box's frame, its key."""
+    ground = slab.vertices[:, [0, 2]]
+    angle = 0.0
+    if len(np.unique(np.round(ground, 6), axis=0)) >= 3:
+        try:
+            transform, _ = oriented_bounds_2D(ground)
+            angle = float(np.degrees(np.arctan2(transform[1, 0], transform[0, 0])))
+        except Exception:  # collinear points: qhull cannot make a hull; keep the world axes
+            angle = 0.0
+    angle = angle % 90.0
+    bottom = float(slab.vertices[:, 1].min())
+    best = None
+    for quarter in range(4):
+        axes = _turn(angle + 90.0 * quarter)
+        local = slab.vertices @ axes  # coordinates along the frame's axes
+        low = local.min(axis=0)
+        low[1] = bottom
+        local = local - low
+        key = mesh_key(local, slab.faces)
+        if best is None or key < best[0]:
+            origin = axes @ low
+            frame = np.eye(4)
+            frame[:3, :3], frame[:3, 3] = axes, origin
+            best = (key, frame, local)
+    assert best is not None
+    key, frame, local = best
+    size = local.max(axis=0)
+    return Component(building, frame, size, local, slab.faces, colors, key, angle)
+
+
+def features(comp: Component) -> np.ndarray:
+    """The feature vector of a component (see FEATURES), from its mesh in its own frame."""
+    v, f = comp.vertices, comp.faces
+    tri = v[f]
+    cross = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
+    area = np.linalg.norm(cross, axis=1) / 2
+    keep = area > 1e-9
+    up = np.divide(cross[:, 1], 2 * area, out=np.zeros(len(f)), where=keep)
+    roofish = keep & (up > 0.05) & (up < 0.999)
+    slope = (
+        float(np.average(np.degrees(np.arccos(up[roofish])), weights=area[roofish]))
+        if roofish.any()
+        else 0.0
+    )
+    intensity = 0.0
+    if comp.colors is not None and len(comp.colors) == len(f) and keep.any():
+        grey = comp.colors[:, :3].astype(float) @ np.array([0.299, 0.587, 0.114]) / 255
+        intensity = float(np.average(grey[keep], weights=area[keep])) * 10
+    return np.array(
+        [
+            _outline_vertices(tri[keep][:, :, [0, 1]], comp.size),
+            _outline_vertices(tri[keep][:, :, [2, 1]], comp.size),
+            comp.size[0],
+            comp.size[1],
+            comp.size[2],
+            comp.angle / 10,
+            slope / 10,
+            intensity,
+        ]
+    )
+
+
+def _outline_vertices(flat: np.ndarray, size: np.ndarray) -> float:
+    """Vertices of the Douglas-Peucker simplified outline of triangles seen from one side (the
+    paper renders the component and simplifies the foreground's outline)."""
+    if len(flat) == 0:
+        return 0.0
+    polygons = shapely.polygons(np.concatenate([flat, flat[:, :1]], axis=1))
+    polygons = polygons[shapely.area(polygons) > 1e-9]
+    if len(polygons) == 0:  # seen edge on: a line
+        return 2.0
+    outline = shapely.union_all(polygons, grid_size=1e-4)
+    simple = shapely.simplify(outline, 0.02 * float(max(size.max(), 1e-3)))
+    rings = shapely.get_parts(simple)
+    return float(sum(len(p.exterior.coords) - 1 for p in rings if p.geom_type == "Polygon"))

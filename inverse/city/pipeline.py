@@ -1,0 +1,444 @@
+"""``bgr infer --kind city``: read, cut, type, group, write (the paper's Figure 2 pipeline).
+
+:func:`infer_city` runs the phases with a progress bar each and returns the grammar's syntax
+tree, its assets (GLB bytes by file name) and, on request, statistics for every level.
+"""
+
+from __future__ import annotations
+
+import io
+import sys
+import warnings
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+import trimesh
+from tqdm import tqdm
+
+from bgr.grammar import nodes as n
+from bgr.grammar.errors import BgrError
+
+from . import emit, tree
+from .components import Component, fit
+from .cuts import cut_heights, slabs
+from .model import CityScene
+from .types import Level, Types, cluster, level_for
+
+
+@dataclass
+class Options:
+    """Everything the command line can set (docs/inverse-city.md)."""
+
+    up: str = "auto"
+    level: int | None = None
+    threshold: float | None = None
+    feature_weights: dict[str, float] | None = None
+    w_mu: float = 1.0  # equation 11
+    w_sigma: float = 1.0
+    tau: float | None = None  # neighbour distance (equation 3); default from the data
+    representative: str = "mean"  # or "fewest" (triangles)
+    assets: str = "city.assets"  # the assets folder as the grammar names it
+    progress: bool = True
+    seed: int = 0
+
+
+@dataclass
+class Placed:
+    """The city at one level, before it is written: everything the grammar says."""
+
+    level: Level
+    terminals: list[emit.Terminal]
+    term_mesh: list[Component]  # the representative component of each terminal
+    rules: list[tree.Rule]
+    city: list[tree.Placement]
+    units: list[emit.Unit]
+    carried: list[tuple[emit.Terminal, tree.Placement, np.ndarray, np.ndarray]]
+    instances: list[tuple[int, np.ndarray, np.ndarray]]  # (terminal, world frame, size) each
+    tau: float
+
+
+@dataclass
+class CityGrammar:
+    module: n.Module
+    assets: dict[str, bytes]  # file name (inside the assets folder) -> GLB
+    scene: CityScene
+    comps: list[Component]
+    placed: Placed
+    types: Types
+    stats: list[dict] = field(default_factory=list)
+
+
+def _bar(options: Options, total: int, what: str) -> tqdm:
+    return tqdm(
+        total=total,
+        desc=what,
+        unit="",
+        disable=not options.progress,
+        file=sys.stderr,
+        leave=False,
+        dynamic_ncols=True,
+    )
+
+
+def decompose(scene: CityScene, options: Options) -> list[Component]:
+    """Every building object cut into components (cut planes, slabs, boxes)."""
+    out: list[Component] = []
+    with _bar(options, len(scene.objects), "cutting buildings") as bar:
+        for index, obj in enumerate(scene.objects):
+            bar.update()
+            if not obj.proceduralize:
+                continue
+            for slab in slabs(obj.vertices, obj.faces, cut_heights(obj.vertices, obj.faces)):
+                colors = None if obj.colors is None else obj.colors[slab.source_faces]
+                out.append(fit(slab, index, colors))
+    return out
+
+
+def place(
+    scene: CityScene, comps: list[Component], types: Types, level: Level, options: Options
+) -> Placed:
+    """The grammar's content at one level: terminals, building kinds, groups, the axiom."""
+    of_comp = level.of_base[types.base_of]
+    count = np.bincount(of_comp, minlength=len(level.representative))
+    order = sorted(range(len(count)), key=lambda t: (-count[t], t))
+    name_of = {t: f"Type{i + 1}" for i, t in enumerate(order)}
+    terminals, term_mesh = [], []
+    for i, t in enumerate(order):
+        rep = comps[types.base_first[level.representative[t]]]
+        sizes = np.array([comps[j].size for j in np.flatnonzero(of_comp == t)])
+        low, high = sizes.min(axis=0), sizes.max(axis=0)
+        span = " x ".join(
+            f"{a:.1f}" if abs(a - b) < 0.05 else f"{a:.1f}-{b:.1f}"
+            for a, b in zip(low, high, strict=True)
+        )
+        terminals.append(
+            emit.Terminal(
+                name_of[t],
+                f"type{i + 1}",
+                f"{options.assets}/type{i + 1}.glb",
+                _colour(rep),
+                f"component type {i + 1}: {_count(int(count[t]), 'instance')}, "
+                f"{span} m (width x height x depth)",
+            )
+        )
+        term_mesh.append(rep)
+    terminal_index = {t: i for i, t in enumerate(order)}
+    grid = tree._grid(level.index)
+    exact = level.index == 0
+
+    # buildings: stacks of components in the frame of the lowest
+    by_building: dict[int, list[int]] = {}
+    for i, c in enumerate(comps):
+        by_building.setdefault(c.building, []).append(i)
+    kinds: dict[tuple, list] = {}
+    instances: list[tuple[int, np.ndarray, np.ndarray]] = []
+    for b, members in by_building.items():
+        members.sort(key=lambda i: (comps[i].frame[1, 3], i))
+        frame = comps[members[0]].frame
+        placed = []
+        for i in members:
+            angle, offset = tree.relative(frame, comps[i].frame)
+            size = comps[i].size
+            placed.append(tree.Placement(name_of[int(of_comp[i])], angle, offset, size))
+            instances.append((terminal_index[int(of_comp[i])], comps[i].frame, size))
+        keys = [tree._key(p, grid) for p in placed]
+        ordering = sorted(range(len(placed)), key=lambda j: keys[j])
+        signature = tuple(keys[j] for j in ordering)
+        centre = np.mean(
+            [comps[i].frame[:3, :3] @ (comps[i].size / 2) + comps[i].frame[:3, 3] for i in members],
+            axis=0,
+        )
+        kinds.setdefault(signature, []).append((b, frame, [placed[j] for j in ordering], centre))
+    # building kinds, most used first
+    kind_list = sorted(kinds.values(), key=lambda v: (-len(v), v[0][0]))
+    rules: list[tree.Rule] = []
+    leaves: dict[int, list[tree.Instance]] = {}
+    units: list[emit.Unit] = []
+    kind_of = np.empty(0, dtype=np.int64)
+    mids = []
+    kind_ids = []
+    for k, found in enumerate(kind_list):
+        name = f"Building{k + 1}"
+        children = found[0][2] if exact else tree._average([f[2] for f in found])
+        rules.append(
+            tree.Rule(
+                name,
+                children,
+                len(found),
+                f"building kind {k + 1}: {_count(len(found), 'instance')}, "
+                f"{_count(len(children), 'component')}",
+            )
+        )
+        low, high = _extent(children)
+        units.append(emit.Unit(name, len(found), low, high))
+        leaves[k] = [tree.Instance(name, f[1], f[3]) for f in found]
+        for f in found:
+            mids.append(f[3])
+            kind_ids.append(k)
+    kind_of = np.array(kind_ids, dtype=np.int64)
+    midpoints = np.array(mids).reshape(-1, 3)
+    tau = options.tau if options.tau is not None else tree.neighbour_radius(midpoints)
+    graph = tree.kind_graph(kind_of, midpoints, tau, options.w_mu, options.w_sigma)
+    shape = tree.communities(graph, options.seed)
+
+    groups: list[tree.Rule] = []
+
+    def new_rule(children: list[tree.Placement], uses: int) -> str:
+        name = f"Group{len(groups) + 1}"
+        groups.append(
+            tree.Rule(
+                name,
+                children,
+                uses,
+                f"neighbourhood pattern {len(groups) + 1}: {uses} instances of "
+                + " ".join(p.rule for p in children),
+            )
+        )
+        low, high = _extent(children, {u.rule: u for u in units})
+        units.append(emit.Unit(name, uses, low, high))
+        return name
+
+    top: list[tree.Instance] = []
+    for part in shape:
+        top += tree.group(part, leaves, tau, grid, new_rule)
+    city = []
+    for inst in sorted(top, key=lambda i: (i.rule, *np.round(i.frame[:3, 3], 3).tolist())):
+        city.append(tree.Placement(inst.rule, tree.turn_of(inst.frame), inst.frame[:3, 3]))
+
+    carried = []
+    for obj in scene.objects:
+        if obj.proceduralize:
+            continue
+        low = obj.vertices.min(axis=0)
+        term = emit.Terminal(
+            f"Object{len(carried) + 1}",
+            f"object{len(carried) + 1}",
+            f"{options.assets}/object{len(carried) + 1}.glb",
+            _colour_of(obj.colors),
+            f"carried through as it is: {obj.kind} {obj.name} ({len(obj.faces)} triangles)",
+        )
+        size = obj.vertices.max(axis=0) - low
+        carried.append(
+            (term, tree.Placement(term.name, 0.0, low, size), obj.vertices - low, obj.faces)
+        )
+    # synthesis uses the units the city repeats, or all building kinds if it repeats none
+    repeated = [u for u in units if u.uses > 1] or units
+    repeated = sorted(repeated, key=lambda u: -u.uses)[:12]
+    return Placed(
+        level, terminals, term_mesh, groups + rules, city, repeated, carried, instances, tau
+    )
+
+
+def _extent(
+    children: list[tree.Placement], units: dict | None = None
+) -> tuple[np.ndarray, np.ndarray]:
+    """The corners of the boxes a rule places, in the rule's own frame."""
+    points = []
+    for p in children:
+        a = np.radians(p.angle)
+        rot = np.array([[np.cos(a), 0, np.sin(a)], [0, 1, 0], [-np.sin(a), 0, np.cos(a)]])
+        if p.size is not None:
+            low, high = np.zeros(3), p.size
+        elif units and p.rule in units:
+            low, high = units[p.rule].low, units[p.rule].high
+        else:
+            low = high = np.zeros(3)
+        corners = np.array(
+            [
+                [x, y, z]
+                for x in (low[0], high[0])
+                for y in (low[1], high[1])
+                for z in (low[2], high[2])
+            ]
+        )
+        points.append(corners @ rot.T + p.offset)
+    allp = np.concatenate(points) if points else np.zeros((1, 3))
+    return allp.min(axis=0), allp.max(axis=0)
+
+
+def _count(number: int, noun: str) -> str:
+    return f"{number} {noun}{'s' if number != 1 else ''}"
+
+
+def _colour(comp: Component) -> str | None:
+    return _colour_of(comp.colors)
+
+
+def _colour_of(colors: np.ndarray | None) -> str | None:
+    """The most common face colour, as ``#rrggbb``; None without colours."""
+    if colors is None or len(colors) == 0:
+        return None
+    values, counts = np.unique(np.asarray(colors)[:, :3], axis=0, return_counts=True)
+    r, g, b = values[int(np.argmax(counts))]
+    return f"#{int(r):02x}{int(g):02x}{int(b):02x}"
+
+
+def glb_bytes(vertices: np.ndarray, faces: np.ndarray) -> bytes:
+    """A mesh as GLB bytes (trimesh's exporter), vertices as given."""
+    mesh = trimesh.Trimesh(np.asarray(vertices, dtype=np.float64), np.asarray(faces), process=False)
+    out = mesh.export(file_type="glb")
+    return bytes(out) if not isinstance(out, bytes) else out
+
+
+def infer_city(
+    path: str | Path, options: Options | None = None, *, stats: bool = False
+) -> CityGrammar:
+    """The grammar of a city model (see the module docstring and docs/inverse-city.md)."""
+    options = options or Options()
+    from .read import read_city
+
+    scene = read_city(path, up=options.up)
+    comps = decompose(scene, options)
+    if not comps and not scene.objects:
+        raise BgrError(f"{path}: no buildings to proceduralize")
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # k-means' empty clusters are dropped by cluster()
+        types = cluster(
+            comps,
+            feature_weights=options.feature_weights,
+            representative=options.representative,
+            seed=options.seed,
+        )
+    level = level_for(types, level=options.level, threshold=options.threshold)
+    placed = place(scene, comps, types, level, options)
+    return build(scene, comps, types, placed, options)
+
+
+def build(
+    scene: CityScene, comps: list[Component], types: Types, placed: Placed, options: Options
+) -> CityGrammar:
+    assets = {}
+    for t, rep in zip(placed.terminals, placed.term_mesh, strict=True):
+        assets[Path(t.path).name] = glb_bytes(rep.vertices, rep.faces)
+    for t, _, vertices, faces in placed.carried:
+        assets[Path(t.path).name] = glb_bytes(vertices, faces)
+    header = _header(scene, comps, types, placed)
+    module = emit.module(
+        header,
+        placed.terminals,
+        placed.rules,
+        placed.city,
+        placed.units,
+        [(t, p) for t, p, _, _ in placed.carried],
+    )
+    return CityGrammar(module, assets, scene, comps, placed, types)
+
+
+def _header(scene: CityScene, comps: list[Component], types: Types, placed: Placed) -> list[str]:
+    offset = ", ".join(f"{v:g}" for v in scene.offset)
+    axes = ", with (x, y, z) = (east, up, -north)" if scene.up == "z" else ""
+    crs = f" in {scene.crs}" if scene.crs else ""
+    lines = [
+        f"# Inferred by bgr infer --kind city from {Path(scene.source).name}: "
+        f"{len(scene.objects)} objects,",
+        f"# {len(comps)} components in {len(placed.terminals)} types (level "
+        f"{placed.level.index} of {len(types.levels) - 1}), {len(placed.rules)} non-terminal "
+        "rules.",
+        f"# Input frame: {scene.up} up; bgr coordinates are the input's minus ({offset}){crs}"
+        f"{axes}.",
+    ]
+    return lines
+
+
+def to_text(grammar: CityGrammar) -> str:
+    from bgr.grammar.formatter import format_module
+
+    buffer = io.StringIO()
+    buffer.write(format_module(grammar.module))
+    return buffer.getvalue()
+
+
+def write(grammar: CityGrammar, text: str, output: Path | None, assets_dir: Path) -> None:
+    """Write the assets folder, then the grammar (``output``; None: standard output).
+
+    The folder is written beside its final place and swapped in, so that a failure leaves the
+    old folder (or none) and never half of the new one; the grammar is written last, atomically.
+    """
+    import os
+    import shutil
+    import tempfile
+
+    assets_dir = Path(assets_dir)
+    assets_dir.parent.mkdir(parents=True, exist_ok=True)
+    staging = Path(tempfile.mkdtemp(prefix=f".{assets_dir.name}-", dir=assets_dir.parent))
+    try:
+        for name, data in grammar.assets.items():
+            (staging / name).write_bytes(data)
+        old = None
+        if assets_dir.exists():
+            old = assets_dir.with_name(f".{assets_dir.name}-old-{os.getpid()}")
+            os.replace(assets_dir, old)
+        os.replace(staging, assets_dir)
+        if old is not None:
+            shutil.rmtree(old, ignore_errors=True)
+    except BaseException:
+        shutil.rmtree(staging, ignore_errors=True)
+        raise
+    if output is None:
+        sys.stdout.write(text)
+    else:
+        from bgr.cli import write_atomic
+
+        write_atomic(Path(output), text)
+
+
+def rebuilt(placed: Placed) -> tuple[np.ndarray, np.ndarray]:
+    """The triangles the grammar of ``placed`` derives on the default lot (each component type's
+    mesh fitted to each instance's box, and the carried objects), computed directly."""
+    verts, faces, count = [], [], 0
+    for terminal, frame, size in placed.instances:
+        rep = placed.term_mesh[terminal]
+        scale = np.divide(size, rep.size, out=np.ones(3), where=rep.size > 1e-12)
+        world = (rep.vertices * scale) @ frame[:3, :3].T + frame[:3, 3]
+        verts.append(world)
+        faces.append(rep.faces + count)
+        count += len(world)
+    for _, p, vertices, f in placed.carried:
+        verts.append(vertices + p.offset)
+        faces.append(f + count)
+        count += len(vertices)
+    if not verts:
+        return np.zeros((0, 3)), np.zeros((0, 3), dtype=np.int64)
+    return np.concatenate(verts), np.concatenate(faces)
+
+
+def level_stats(source: str | Path, grammar: CityGrammar, options: Options) -> list[dict]:
+    """For every level: the counts of the paper's Table 1, sizes, and the geometric error of
+    the derived city against the input (symmetric Hausdorff and Chamfer distances)."""
+    from .distance import surface_distances
+
+    scene, types = grammar.scene, grammar.types
+    comps = grammar.comps
+    parts = list(scene.objects)
+    in_v = np.concatenate([o.vertices for o in parts]) if parts else np.zeros((0, 3))
+    offsets = np.cumsum([0] + [len(o.vertices) for o in parts])
+    in_f = (
+        np.concatenate([o.faces + offsets[i] for i, o in enumerate(parts)])
+        if parts
+        else np.zeros((0, 3), dtype=np.int64)
+    )
+    rows = []
+    for level in types.levels:
+        placed = place(scene, comps, types, level, options)
+        built = build(scene, comps, types, placed, options)
+        text = to_text(built)
+        out_v, out_f = rebuilt(placed)
+        d = surface_distances(in_v, in_f, out_v, out_f)
+        rows.append(
+            {
+                "level": level.index,
+                "components": len(comps),
+                "terminals": len(placed.terminals) + len(placed.carried),
+                "nonterminals": len(placed.rules) + 3,  # and Lot, City, Synthesis
+                "rules": len(placed.rules) + 4 + len(placed.terminals) + len(placed.carried),
+                "input_triangles": int(len(in_f)),
+                "output_triangles": int(sum(len(m.faces) for m in placed.term_mesh))
+                + int(sum(len(f) for *_, f in placed.carried)),
+                "input_bytes": Path(source).stat().st_size,
+                "output_bytes": len(text.encode()) + sum(len(b) for b in built.assets.values()),
+                "hausdorff": d.hausdorff,
+                "chamfer": d.chamfer,
+            }
+        )
+    return rows
