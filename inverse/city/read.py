@@ -35,6 +35,8 @@ from .model import CityObject, CityScene
 if TYPE_CHECKING:
     import trimesh
 
+__all__ = ["read_city"]  # the helpers below are the module's own (tests reach into some)
+
 # extension (lower case) -> format; the longest matching extension wins
 EXTENSIONS = {
     ".obj": "obj",
@@ -349,9 +351,6 @@ class ObjText:
                 s += 1
             self.starts[i] = s
 
-    def __len__(self) -> int:
-        return len(self.starts)
-
     def lines_of(self, keyword: str) -> np.ndarray:
         """The (0-based) lines whose first word is ``keyword`` (one character)."""
         first, second = self.buf[self.starts], self.buf[self.starts + 1]
@@ -455,17 +454,23 @@ def _bulk(raw: np.ndarray, n: int, kind: type) -> tuple[np.ndarray | None, np.nd
     if raw.max() > 127:  # numpy would read some non-ASCII digits; the line parser refuses them
         return None, counts
     pick = None
-    slash = raw == ord("/")
-    if kind is int and slash.any():
+    if kind is int:
         # every field between blanks and slashes is a number; a word's first field is its index
+        slash = raw == ord("/")
         cut = blank | slash
         field = ~cut
         field[1:] &= cut[:-1]
         if (word & slash).any():  # a word starting with "/" has no vertex index
             return None, counts
-        pick = np.flatnonzero(word[field])
-        raw = np.where(slash, np.uint8(32), raw)
-        total = int(field.sum())
+        # numpy reads a lone sign as 0, and "- 1" as -1: a sign must start a field, a digit next
+        sign = np.flatnonzero((raw == ord("-")) | (raw == ord("+")))
+        after = raw[np.minimum(sign + 1, len(raw) - 1)]
+        if not (field[sign] & (after >= ord("0")) & (after <= ord("9"))).all():
+            return None, counts
+        if slash.any():
+            pick = np.flatnonzero(word[field])
+            raw = np.where(slash, np.uint8(32), raw)
+            total = int(field.sum())
     try:
         values = np.fromstring(raw.tobytes(), dtype=dtype, sep=" ")
     except ValueError:
@@ -492,7 +497,12 @@ def _vertex_lines(obj: ObjText, v_lines: np.ndarray) -> tuple[np.ndarray, np.nda
         for j, token in enumerate(tokens, start=1):
             number = _NUMBER.fullmatch(token) is not None
             if _NOT_FINITE.fullmatch(token) or (number and not math.isfinite(float(token))):
-                raise obj.error(i, j, "a vertex coordinate is not a finite number")
+                raise obj.error(
+                    i,
+                    j,
+                    "a vertex coordinate is not a finite number",
+                    "NaN and infinity place nothing: the exporter wrote a point it could not place",
+                )
             if not number:
                 raise obj.error(i, j, "a vertex coordinate is not a number", OBJ_VERTEX)
         if len(tokens) < 3:
@@ -586,7 +596,9 @@ def _obj_corners(
     raise obj.error(
         line,
         token,
-        f"vertex index {value} is out of range",
+        f"vertex index {value} is out of range"
+        if value < 2**62
+        else "a vertex index far out of range",
         f"the file has {len(v_lines)} vertices (`v` lines)",
     )
 
