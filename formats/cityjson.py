@@ -515,6 +515,8 @@ def read_cityjson(path: str | Path, lod: str | None = None) -> CityModel:
         transform = head.get("transform")
         model = CityModel({}, (head.get("metadata") or {}).get("referenceSystem"), transform)
         for doc in [head, *features]:
+            if "vertices" not in doc:  # required of every CityJSON object and feature
+                raise ValueError('it has no "vertices"')
             vertices = np.asarray(doc.get("vertices") or np.zeros((0, 3)), dtype=np.float64)
             if transform:
                 vertices = vertices * transform["scale"] + transform["translate"]

@@ -85,7 +85,8 @@ def _trs(t, r, s) -> np.ndarray:
     return m
 
 
-def _node_matrix(node: dict) -> np.ndarray:
+def node_matrix(node: dict) -> np.ndarray:
+    """A node's local 4x4 matrix, from ``matrix`` or from its translation, rotation and scale."""
     if "matrix" in node:
         return np.array(node["matrix"], dtype=np.float64).reshape(4, 4).T  # column-major
     return _trs(
@@ -100,9 +101,27 @@ def _to_srgb(linear) -> np.ndarray:
     return np.where(c <= 0.0031308, c * 12.92, 1.055 * c ** (1 / 2.4) - 0.055)
 
 
+def scene_roots(gltf: dict) -> list[int]:
+    """The root nodes of the default scene (without scenes: every node that is nobody's child)."""
+    if gltf.get("scenes"):
+        return list(gltf["scenes"][gltf.get("scene", 0)].get("nodes", []))
+    children = {c for node in gltf.get("nodes", []) for c in node.get("children", [])}
+    return [i for i in range(len(gltf.get("nodes", []))) if i not in children]
+
+
 def read_glb(path: Path | str) -> trimesh.Trimesh:
     """World-space triangles of every node of the default scene, with per-face colours."""
     gltf, blob = parse(read_input(path, "model file"))
+    return world_mesh(gltf, blob, scene_roots(gltf))
+
+
+def world_mesh(
+    gltf: dict, blob: bytes, roots: list[int], parent: np.ndarray | None = None
+) -> trimesh.Trimesh:
+    """World-space triangles of the nodes ``roots`` and everything under them, placed by
+    ``parent`` (the 4x4 world matrix of their parent; identity for a scene's roots), with
+    per-face sRGB colours.  Callers that want one mesh per subtree (one per building) call it
+    once per subtree."""
     nodes, meshes, materials = (
         gltf.get("nodes", []),
         gltf.get("meshes", []),
@@ -111,10 +130,10 @@ def read_glb(path: Path | str) -> trimesh.Trimesh:
     verts, faces, colours = [], [], []
     count = 0
 
-    def visit(index: int, parent: np.ndarray) -> None:
+    def visit(index: int, above: np.ndarray) -> None:
         nonlocal count
         node = nodes[index]
-        world = parent @ _node_matrix(node)
+        world = above @ node_matrix(node)
         if "mesh" in node:
             inst = node.get("extensions", {}).get("EXT_mesh_gpu_instancing")
             if inst:
@@ -163,13 +182,8 @@ def read_glb(path: Path | str) -> trimesh.Trimesh:
         for child in node.get("children", []):
             visit(child, world)
 
-    if gltf.get("scenes"):
-        roots = gltf["scenes"][gltf.get("scene", 0)].get("nodes", [])
-    else:  # no scene: every node that is nobody's child
-        children = {c for node in nodes for c in node.get("children", [])}
-        roots = [i for i in range(len(nodes)) if i not in children]
     for root in roots:
-        visit(root, np.eye(4))
+        visit(root, np.eye(4) if parent is None else parent)
     if not faces:
         return trimesh.Trimesh(np.zeros((0, 3)), np.zeros((0, 3), dtype=np.int64), process=False)
     return trimesh.Trimesh(
