@@ -143,14 +143,23 @@ def features(comp: Component) -> np.ndarray:
 
 def _outline_vertices(flat: np.ndarray, size: np.ndarray) -> float:
     """Vertices of the Douglas-Peucker simplified outline of triangles seen from one side (the
-    paper renders the component and simplifies the foreground's outline)."""
+    paper renders the component and simplifies the foreground's outline).
+
+    ``flat`` is the triangles projected on the view plane.  Of a closed mesh the faces turned
+    towards the viewer cover the whole silhouette, so only they are merged (half the work);
+    an open surface that has none turned this way is merged from the other side."""
     if len(flat) == 0:
         return 0.0
-    polygons = shapely.polygons(np.concatenate([flat, flat[:, :1]], axis=1))
-    polygons = polygons[shapely.area(polygons) > 1e-9]
-    if len(polygons) == 0:  # seen edge on: a line
+    e1, e2 = flat[:, 1] - flat[:, 0], flat[:, 2] - flat[:, 0]
+    facing = e1[:, 0] * e2[:, 1] - e1[:, 1] * e2[:, 0]
+    chosen = flat[facing > 1e-9] if np.any(facing > 1e-9) else flat[facing < -1e-9]
+    if len(chosen) == 0:  # seen edge on: a line
         return 2.0
-    outline = shapely.union_all(polygons, grid_size=1e-4)
+    polygons = shapely.polygons(np.concatenate([chosen, chosen[:, :1]], axis=1))
+    try:
+        outline = shapely.union_all(polygons)
+    except shapely.errors.GEOSException:  # nearly coincident edges: merge on a 0.1 mm grid
+        outline = shapely.union_all(polygons, grid_size=1e-4)
     simple = shapely.simplify(outline, 0.02 * float(max(size.max(), 1e-3)))
     rings = shapely.get_parts(simple)
     return float(sum(len(p.exterior.coords) - 1 for p in rings if p.geom_type == "Polygon"))
