@@ -222,12 +222,22 @@ def place(
         carried.append(
             (term, tree.Placement(term.name, 0.0, low, size), obj.vertices - low, obj.faces)
         )
-    # synthesis uses the units the city repeats, or all building kinds if it repeats none
-    repeated = [u for u in units if u.uses > 1] or units
-    repeated = sorted(repeated, key=lambda u: -u.uses)[:12]
+    repeated = synthesis_units(units)
     return Placed(
         level, terminals, term_mesh, groups + rules, city, repeated, carried, instances, tau
     )
+
+
+def synthesis_units(units: list[emit.Unit], most: int = 12) -> list[emit.Unit]:
+    """What synthesis puts on new lots: the buildings and groups the city repeats (or all of them
+    when it repeats none), without the flat ones (under 2 m: roads, terrain, water read as
+    objects) and the ones over twice the median width (a plot that size swallows a lot), the
+    ``most`` most used."""
+    standing = [u for u in units if u.high[1] - u.low[1] >= 2.0] or units
+    widths = np.array([u.high[0] - u.low[0] for u in standing])
+    typical = [u for u, w in zip(standing, widths, strict=True) if w <= 2 * np.median(widths)]
+    chosen = [u for u in typical if u.uses > 1] or typical
+    return sorted(chosen, key=lambda u: -u.uses)[:most]
 
 
 def _extent(
