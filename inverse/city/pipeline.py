@@ -304,12 +304,15 @@ def infer_city(
         raise BgrError(f"{path}: no buildings to proceduralize")
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")  # k-means' empty clusters are dropped by cluster()
-        types = cluster(
-            comps,
-            feature_weights=options.feature_weights,
-            representative=options.representative,
-            seed=options.seed,
-        )
+        bar = _bar(options, len({c.key for c in comps}), "typing components")
+        with bar:
+            types = cluster(
+                comps,
+                progress=bar,
+                feature_weights=options.feature_weights,
+                representative=options.representative,
+                seed=options.seed,
+            )
     level = level_for(types, level=options.level, threshold=options.threshold)
     placed = place(scene, comps, types, level, options)
     return build(scene, comps, types, placed, options)
@@ -319,10 +322,13 @@ def build(
     scene: CityScene, comps: list[Component], types: Types, placed: Placed, options: Options
 ) -> CityGrammar:
     assets = {}
-    for t, rep in zip(placed.terminals, placed.term_mesh, strict=True):
-        assets[Path(t.path).name] = glb_bytes(rep.vertices, rep.faces)
-    for t, _, vertices, faces in placed.carried:
-        assets[Path(t.path).name] = glb_bytes(vertices, faces)
+    with _bar(options, len(placed.terminals) + len(placed.carried), "writing meshes") as bar:
+        for t, rep in zip(placed.terminals, placed.term_mesh, strict=True):
+            assets[Path(t.path).name] = glb_bytes(rep.vertices, rep.faces)
+            bar.update()
+        for t, _, vertices, faces in placed.carried:
+            assets[Path(t.path).name] = glb_bytes(vertices, faces)
+            bar.update()
     header = _header(scene, comps, types, placed)
     module = emit.module(
         header,

@@ -56,8 +56,10 @@ def cluster(
     feature_weights: dict[str, float] | None = None,
     representative: str = "mean",
     seed: int = 0,
+    progress=None,
 ) -> Types:
-    """Level 0 by equal meshes, then the k-means hierarchy on the level-0 types."""
+    """Level 0 by equal meshes, then the k-means hierarchy on the level-0 types; ``progress``
+    (a tqdm bar) counts the level-0 types as their feature vectors are made."""
     keys = [c.key for c in components]
     unique, first, base_of, count = np.unique(
         np.array(keys), return_index=True, return_inverse=True, return_counts=True
@@ -68,7 +70,7 @@ def cluster(
     base_of = renumber[base_of.reshape(-1)]
     first, count = first[order], count[order]
     w = weights(feature_weights)
-    vectors = np.array([features(components[i]) for i in first]) * w
+    vectors = np.array([_counted(features(components[i]), progress) for i in first]) * w
     triangles = np.array([len(components[i].faces) for i in first])
     n0 = len(first)
     levels = [Level(0, np.arange(n0), np.arange(n0), 0.0)]
@@ -91,6 +93,13 @@ def cluster(
         error = float(np.max(np.linalg.norm(vectors - vectors[reps[labels]], axis=1)))
         levels.append(Level(len(levels), labels.copy(), reps, error))
     return Types(base_of, first, count, vectors, levels)
+
+
+def _counted(value, progress):
+    """``value``, after telling ``progress`` (a tqdm bar, or None) that one more is done."""
+    if progress is not None:
+        progress.update()
+    return value
 
 
 def _representatives(
