@@ -251,6 +251,7 @@ def test_mesh_distances_against_brute_force(monkeypatch, chunk):
     pieces), degenerate ones, and points near the surface, far from it and off its grid; with a
     tiny chunk too, so that the pairs are cut at every place."""
     monkeypatch.setattr(distance, "CHUNK_PAIRS", chunk)
+    monkeypatch.setattr(distance, "CHUNK_POINTS", min(chunk, distance.CHUNK_POINTS))
     rng = np.random.default_rng(1)
     small = rng.uniform(-20, 20, (300, 1, 3)) + rng.normal(size=(300, 3, 3))
     large = rng.uniform(-20, 20, (5, 1, 3)) + rng.normal(size=(5, 3, 3)) * 15
