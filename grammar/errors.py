@@ -71,6 +71,10 @@ class BgrError(Exception):
         self.hint: str | None = first.hint
         super().__init__(self.render())
 
+    def __reduce__(self):
+        # rebuilt from its diagnostics, not its text, when a worker process sends it back
+        return (type(self), (self.diagnostics,))
+
     def render(self) -> str:
         text = "\n".join(d.render() for d in self.diagnostics)
         if len(self.diagnostics) > 1:

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import os
 from collections.abc import Iterable, Mapping
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field
 from numbers import Integral, Real
 from pathlib import Path
 
@@ -12,6 +12,7 @@ from bgr.grammar.checker import Grammar
 from bgr.grammar.errors import BgrError, Diagnostic, Warnings
 from bgr.grammar.loader import load
 
+from .batch import Job, derive_lots
 from .engine import Engine
 from .limits import (
     DEFAULT_MAX_DEPTH,
@@ -19,9 +20,9 @@ from .limits import (
     DEFAULT_MAX_TRIANGLES,
     default_max_memory,
 )
-from .lots import DEFAULT_LOT, Lot, attr_overrides, parse_lot_option, rectangle
+from .lots import DEFAULT_LOT, Lot, parse_lot_option, rectangle
 from .randomness import child_hash, name_hash, root_hash
-from .terminals import TerminalTable
+from .terminals import TerminalTable, concat
 from .values import SEED_RANGE, number_problem
 
 
@@ -90,6 +91,44 @@ def derive(
     a seed outside -2**63 .. 2**64 - 1, limits under 1, attrs that are not finite numbers of at
     most 1e9, booleans or strings, or a lot of any other form is a :class:`bgr.BgrError`.
     """
+    job, lots, warnings = prepare(
+        grammar,
+        seed,
+        attrs,
+        lot,
+        max_depth=max_depth,
+        max_shapes=max_shapes,
+        max_triangles=max_triangles,
+        max_memory=max_memory,
+        start=start,
+        strict=strict,
+        allow_paths=allow_paths,
+    )
+    parts = []
+    for result in derive_lots(job, lots):
+        warnings.items.extend(result.warnings)
+        parts.append(result.table)
+    table = concat(parts, site=_site(lots), grammar=str(job.grammar.path or ""))
+    return Result(table, seed, job.values, _once(warnings.items))
+
+
+def prepare(
+    grammar: Grammar | str | os.PathLike,
+    seed: int = 0,
+    attrs: dict | None = None,
+    lot: str | tuple[float, float] | list[Lot] | None = None,
+    *,
+    max_depth: int = DEFAULT_MAX_DEPTH,
+    max_shapes: int = DEFAULT_MAX_SHAPES,
+    max_triangles: int = DEFAULT_MAX_TRIANGLES,
+    max_memory: int | None = None,
+    start: str | None = None,
+    strict: bool = False,
+    allow_paths: Iterable[str | os.PathLike] = (),
+) -> tuple[Job, list[Lot], Warnings]:
+    """The checks of :func:`derive`, and what deriving its lots one by one needs: the run's
+    :class:`Job`, its lots, and the warnings reading the lots raised.  ``bgr derive`` uses it
+    to derive lots on workers and write them as they come (:mod:`bgr.interpreter.batch`)."""
     if not isinstance(grammar, Grammar):
         grammar = load(grammar, allow_paths=allow_paths)
     _check_seed(seed)
@@ -97,58 +136,35 @@ def derive(
     attrs = _checked_attrs(attrs)
     warnings = Warnings(strict)
     lots = _lots(lot, warnings)
+    _site(lots)
     values = Engine(grammar, seed, attrs, max_depth, max_shapes).attrs  # the run's attrs
     if max_memory is None:
         max_memory = default_max_memory()
-    table = TerminalTable(site=_site(lots))
-    table.grammar = str(grammar.path or "")
-    shared_cache: dict = {}
-    shapes = triangles = 0  # the budgets are the run's, carried from lot to lot
-    several = len(lots) > 1
-    for i, each in enumerate(lots):
-        lot_name = each.name or (f"lot {i}" if several else "")
-        try:
-            overrides = dict(attrs)
-            overrides.update(attr_overrides(each, values, warnings))
-            engine = Engine(
-                grammar,
-                seed,
-                overrides,
-                max_depth,
-                max_shapes,
-                lot_index=i,
-                warnings=warnings,
-                lot_name=lot_name,
-                max_triangles=max_triangles,
-                max_memory=max_memory,
-            )
-            engine.table = table
-            first_row = len(table)
-            engine.split_cache = shared_cache
-            engine.shapes, engine.triangles = shapes, triangles
-            engine.derive(each.shape.copy(), start, index=i, several=several)
-            shapes, triangles = engine.shapes, engine.triangles
-        except BgrError as e:
-            raise _naming(e, lot_name) from None
-        lot_shape = each.shape  # its frame: the inverse modules read a face's side in it
-        name = start or grammar.start
-        table.lots.append(
-            {
-                "path": f"{name}.{i}" if several else name,
-                "origin": list(lot_shape.origin),
-                "axes": [list(a) for a in lot_shape.axes],
-                "size": list(lot_shape.size),
-                # what the output files say of the building: its terminals are rows
-                # first..last-1 (lots are derived one after another), its name, its attrs after
-                # the feature's overrides and the feature's own properties
-                "rows": [first_row, len(table)],
-                "id": each.feature_id,
-                "name": each.feature_id if each.feature_id is not None else f"lot-{i}",
-                "attrs": dict(engine.attrs),
-                "properties": dict(each.properties),
-            }
-        )
-    return Result(table.freeze(), seed, values, list(warnings.items))
+    job = Job(
+        grammar,
+        seed,
+        attrs,
+        values,
+        start=start,
+        strict=strict,
+        several=len(lots) > 1,
+        max_depth=max_depth,
+        max_shapes=max_shapes,
+        max_triangles=max_triangles,
+        max_memory=max_memory,
+    )
+    return job, lots, warnings
+
+
+def _once(items: list[Diagnostic]) -> list[Diagnostic]:
+    """Warnings in order, each once (lots derived apart may warn alike)."""
+    seen, out = set(), []
+    for d in items:
+        key = (d.path, d.line, d.column, d.message)
+        if key not in seen:
+            seen.add(key)
+            out.append(d)
+    return out
 
 
 def _site(lots: list[Lot]) -> dict | None:
@@ -162,20 +178,6 @@ def _site(lots: list[Lot]) -> dict | None:
             "lots of one GeoJSON file, or lots in plain metres, together"
         )
     return None if site is None else {"crs": site["crs"], "origin": list(site["origin"])}
-
-
-def _naming(error: BgrError, lot_name: str) -> BgrError:
-    """The error with the lot it happened on named at the start of each message (the location
-    stays the grammar's ``file:line:col``); unchanged when the run has one unnamed lot."""
-    if not lot_name:
-        return error
-    named = [
-        d
-        if d.message.startswith(f"{lot_name}: ")
-        else replace(d, message=f"{lot_name}: {d.message}")
-        for d in error.diagnostics
-    ]
-    return type(error)(named)
 
 
 def _shown(value: object) -> str:

@@ -104,3 +104,66 @@ def world_vertices(table: TerminalTable, rows: np.ndarray, mesh: UnitMesh) -> np
     """(len(rows), V, 3) world positions of one unit mesh placed at the given terminals."""
     local = mesh.vertices[None, :, :] * table.size[rows][:, None, :]
     return table.origin[rows][:, None, :] + np.einsum("nvk,nkj->nvj", local, table.axes[rows])
+
+
+def lot_tables(table: TerminalTable) -> list[TerminalTable]:
+    """The table cut into one table per lot (its ``rows`` range), each with only the unit meshes
+    its rows use and its lot's ``rows`` counted from 0: what the streaming writers take, so that
+    writing a whole table and writing lots as they are derived give the same bytes.  A table
+    without lots is one part."""
+    table.freeze()
+    if not table.lots:
+        return [table]
+    parts = []
+    for lot in table.lots:
+        first, end = (int(v) for v in lot.get("rows", (0, 0)))
+        part = TerminalTable(site=table.site, grammar=table.grammar)
+        part.label, part.rule, part.path = (
+            table.label[first:end],
+            table.rule[first:end],
+            table.path[first:end],
+        )
+        part.material = table.material[first:end]
+        part.origin, part.axes = table.origin[first:end], table.axes[first:end]
+        part.size, part.color = table.size[first:end], table.color[first:end]
+        used, local = np.unique(table.mesh[first:end], return_inverse=True)
+        part.mesh = local.astype(np.int32).reshape(-1)
+        for mesh_id in used:
+            part.library.meshes.append(table.library.meshes[int(mesh_id)])
+        part.lots = [{**lot, "rows": [0, end - first]}]
+        part.frozen = True
+        parts.append(part)
+    return parts
+
+
+def concat(
+    parts: list[TerminalTable], site: dict | None = None, grammar: str = ""
+) -> TerminalTable:
+    """One table of several (frozen) ones in order: rows appended, unit meshes merged (equal ones
+    stored once, in order of first use), each lot's ``rows`` moved to its place."""
+    out = TerminalTable(site=site, grammar=grammar)
+    meshes, lots = [], []
+    at = 0
+    for part in parts:
+        part.freeze()
+        remap = np.array([out.library.add(m) for m in part.library.meshes] or [0], dtype=np.int32)
+        meshes.append(remap[part.mesh] if len(part) else part.mesh)
+        out.label += part.label
+        out.rule += part.rule
+        out.path += part.path
+        out.material += part.material
+        for lot in part.lots:
+            first, end = lot.get("rows", (0, len(part)))
+            lots.append({**lot, "rows": [at + int(first), at + int(end)]})
+        at += len(part)
+    out.lots = lots
+
+    def stacked(column: str, shape: tuple) -> np.ndarray:
+        arrays = [getattr(p, column) for p in parts]
+        return np.concatenate(arrays) if arrays else np.zeros(shape)
+
+    out.origin, out.axes = stacked("origin", (0, 3)), stacked("axes", (0, 3, 3))
+    out.size, out.color = stacked("size", (0, 3)), stacked("color", (0, 3))
+    out.mesh = np.concatenate(meshes).astype(np.int32) if meshes else np.zeros(0, np.int32)
+    out.frozen = True
+    return out

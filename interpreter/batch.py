@@ -1,0 +1,362 @@
+"""Deriving many lots: one after another in this process, on a local process pool
+(``--workers N``), or on a Dask cluster (``--dask ADDRESS``) — with the same bytes out.
+
+Every lot is derived on its own, by a fresh :class:`Engine` into its own small terminal table,
+from the global seed and the lot's index in the run (LANGUAGE.md section 9: a shape's random
+stream depends only on the seed and its derivation path, and a lot's path starts with its
+index).  Nothing a lot makes depends on which process derived it or on the lots derived before
+it, so the results can be computed anywhere and put back in lot order.
+
+Lots are sent out in batches and a bounded number of batches is in flight at once; results are
+yielded in lot order as soon as they are ready, so a caller that writes each lot and drops it
+(the streaming writers of :mod:`bgr.formats.sinks`) holds a few batches, not the city.
+
+The budgets (``max_shapes``, ``max_triangles``) hold for the whole run.  Derived in this
+process, each lot starts from the counts of the lots before it, so a runaway stops mid-lot;
+derived elsewhere, each lot gets the whole budget and this process adds the counts up as the
+results come in.  A run that succeeds writes the same files either way.
+"""
+
+from __future__ import annotations
+
+import itertools
+import math
+import multiprocessing
+import os
+import uuid
+from collections import deque
+from collections.abc import Callable, Iterable, Iterator
+from concurrent.futures import Future, ProcessPoolExecutor
+from dataclasses import dataclass, field, replace
+
+from bgr.grammar.checker import Grammar
+from bgr.grammar.errors import BgrError, Diagnostic, Warnings
+
+from .engine import Engine
+from .limits import default_max_memory
+from .lots import Lot, attr_overrides
+from .terminals import TerminalTable
+
+# the split cache (pure: sizes -> placed pieces) is kept across the lots one process derives,
+# and emptied when it holds more entries than this, so that a long run does not grow with it
+CACHE_ENTRIES = 50_000
+
+
+@dataclass
+class Job:
+    """What deriving any lot of a run needs besides the lot: sent once to every worker."""
+
+    grammar: Grammar
+    seed: int
+    attrs: dict  # the caller's attr overrides (--set), checked
+    values: dict  # the run's attr values (grammar defaults with attrs), which properties override
+    start: str | None = None
+    strict: bool = False
+    several: bool = True  # lots are named "lot 3" and paths "Lot.3" when the run has several
+    max_depth: int = 256
+    max_shapes: int = 3_500_000
+    max_triangles: int = 20_000_000
+    max_memory: int | None = None  # None: 80 % of the memory available to the process deriving
+    # names the run in a worker that outlives it (a Dask worker): its split cache is the run's
+    token: str = field(default_factory=lambda: uuid.uuid4().hex)
+
+
+@dataclass
+class LotResult:
+    """One lot derived: its terminals (a frozen table with the lot as ``lots[0]``, rows from 0),
+    the warnings it raised, the shapes and triangles it made; or the error that stopped it."""
+
+    index: int
+    table: TerminalTable | None
+    warnings: list[Diagnostic] = field(default_factory=list)
+    shapes: int = 0
+    triangles: int = 0
+    error: BgrError | None = None
+
+
+def lot_name(lot: Lot, index: int, several: bool) -> str:
+    """How messages name a lot: its feature ("feature 12 (id 4253124)"), else "lot N"."""
+    return lot.name or (f"lot {index}" if several else "")
+
+
+def derive_lot(
+    job: Job,
+    index: int,
+    lot: Lot,
+    *,
+    shapes: int = 0,
+    triangles: int = 0,
+    cache: dict | None = None,
+) -> LotResult:
+    """Derive one lot; ``shapes`` and ``triangles`` are the run's counts so far (the budgets
+    are the run's).  A BgrError is returned in the result, naming the lot, not raised."""
+    name = lot_name(lot, index, job.several)
+    warnings = Warnings(job.strict)
+    max_memory = job.max_memory if job.max_memory is not None else default_max_memory()
+    try:
+        overrides = dict(job.attrs)
+        overrides.update(attr_overrides(lot, job.values, warnings))
+        engine = Engine(
+            job.grammar,
+            job.seed,
+            overrides,
+            job.max_depth,
+            job.max_shapes,
+            lot_index=index,
+            warnings=warnings,
+            lot_name=name,
+            max_triangles=job.max_triangles,
+            max_memory=max_memory,
+        )
+        table = engine.table
+        if cache is not None:
+            engine.split_cache = cache
+        engine.shapes, engine.triangles = shapes, triangles
+        engine.derive(lot.shape.copy(), job.start, index=index, several=job.several)
+    except BgrError as e:
+        return LotResult(index, None, list(warnings.items), error=naming(e, name))
+    rule = job.start or job.grammar.start
+    frame = lot.shape  # the lot's frame: the inverse modules read a face's side in it
+    table.grammar = str(job.grammar.path or "")
+    table.site = lot.site
+    table.lots.append(
+        {
+            "path": f"{rule}.{index}" if job.several else rule,
+            "origin": list(frame.origin),
+            "axes": [list(a) for a in frame.axes],
+            "size": list(frame.size),
+            # what the output files say of the building: its terminals (rows), its name, its
+            # attrs after the feature's overrides and the feature's own properties
+            "rows": [0, len(table)],
+            "id": lot.feature_id,
+            "name": lot.feature_id if lot.feature_id is not None else f"lot-{index}",
+            "attrs": dict(engine.attrs),
+            "properties": dict(lot.properties),
+        }
+    )
+    return LotResult(
+        index,
+        table.freeze(),
+        list(warnings.items),
+        engine.shapes - shapes,
+        engine.triangles - triangles,
+    )
+
+
+def naming(error: BgrError, name: str) -> BgrError:
+    """The error with the lot it happened on named at the start of each message (the location
+    stays the grammar's ``file:line:col``); unchanged when the run has one unnamed lot."""
+    if not name:
+        return error
+    named = [
+        d if d.message.startswith(f"{name}: ") else replace(d, message=f"{name}: {d.message}")
+        for d in error.diagnostics
+    ]
+    return type(error)(named)
+
+
+def derive_lots(
+    job: Job,
+    lots: Iterable[Lot],
+    *,
+    workers: int = 1,
+    dask: str | None = None,
+    batch_size: int | None = None,
+    count: int | None = None,
+) -> Iterator[LotResult]:
+    """Every lot's :class:`LotResult`, in lot order; the first lot that fails raises its
+    BgrError (after the results before it), as a serial run would.
+
+    ``workers`` > 1 derives on a local process pool; ``dask`` (a scheduler address, or
+    ``"local"`` for a LocalCluster of ``workers`` processes) on a Dask cluster.  ``count`` (the
+    number of lots, when known) sizes the batches.
+    """
+    if workers < 1:
+        raise BgrError(f"--workers must be at least 1, got {workers}")
+    if count is None and hasattr(lots, "__len__"):
+        count = len(lots)  # type: ignore[arg-type]
+    numbered = enumerate(lots)
+    if dask is None and workers == 1:
+        yield from _serial(job, numbered)
+        return
+    size = batch_size or _batch_size(count, workers)
+    batches = iter(lambda: list(itertools.islice(numbered, size)), [])
+    window = 4 * workers
+    if dask is not None:
+        results = _on_dask(job, batches, dask, workers, window)
+    else:
+        results = _on_pool(job, batches, workers, window)
+    shapes = triangles = 0
+    for result in results:
+        shapes += result.shapes
+        triangles += result.triangles
+        yield _checked(job, result, shapes, triangles)
+
+
+def _serial(job: Job, numbered: Iterator[tuple[int, Lot]]) -> Iterator[LotResult]:
+    cache: dict = {}
+    shapes = triangles = 0
+    for index, lot in numbered:
+        if len(cache) > CACHE_ENTRIES:
+            cache.clear()
+        result = derive_lot(job, index, lot, shapes=shapes, triangles=triangles, cache=cache)
+        if result.error is not None:
+            raise result.error
+        shapes += result.shapes
+        triangles += result.triangles
+        yield result
+
+
+def _checked(job: Job, result: LotResult, shapes: int, triangles: int) -> LotResult:
+    """A result from a worker, raised if it failed or if the run's budgets are now passed."""
+    if result.error is not None:
+        raise result.error
+    for made, limit, what, option in (
+        (shapes, job.max_shapes, "shapes", "--max-shapes"),
+        (triangles, job.max_triangles, "triangles of terminals", "--max-triangles"),
+    ):
+        if made > limit:
+            raise BgrError(
+                Diagnostic(
+                    str(job.grammar.path or ""),
+                    0,
+                    0,
+                    f"the derivation made more than {limit:,} {what} (all lots together, "
+                    f"after lot {result.index})",
+                    f"derive fewer lots at once, or raise the budget with {option} N",
+                )
+            )
+    return result
+
+
+def _batch_size(count: int | None, workers: int) -> int:
+    """Lots per batch: small enough that every worker gets several batches (the last one to
+    finish does not idle the others long), large enough to amortise sending them."""
+    if count is None:
+        return 16
+    return max(1, min(32, math.ceil(count / (8 * workers))))
+
+
+# --------------------------------------------------------------------------------------------
+# a local process pool
+
+_JOB: Job | None = None  # the job of this worker process (set by _start_worker)
+_CACHE: dict = {}  # the split cache of the run named by _CACHE_OF
+_CACHE_OF = ""
+
+
+def _start_worker(job: Job) -> None:
+    global _JOB
+    _JOB = job
+
+
+def _pool_batch(batch: list[tuple[int, Lot]]) -> list[LotResult]:
+    assert _JOB is not None, "the pool's initializer did not run"
+    return derive_batch(_JOB, batch)
+
+
+def derive_batch(job: Job, batch: list[tuple[int, Lot]]) -> list[LotResult]:
+    """Derive a batch of (index, lot) pairs in a worker; a failed lot ends the batch (the lots
+    after it would not be written)."""
+    global _CACHE_OF
+    if job.token != _CACHE_OF:  # a cache's keys are ids of one grammar's nodes
+        _CACHE.clear()
+        _CACHE_OF = job.token
+    out = []
+    for index, lot in batch:
+        if len(_CACHE) > CACHE_ENTRIES:
+            _CACHE.clear()
+        result = derive_lot(job, index, lot, cache=_CACHE)
+        out.append(result)
+        if result.error is not None:
+            break
+    return out
+
+
+def _context():
+    """forkserver where the platform has it: workers start from a clean process (forking one
+    whose threads hold locks — a progress bar's — can hang); spawn elsewhere."""
+    methods = multiprocessing.get_all_start_methods()
+    return multiprocessing.get_context("forkserver" if "forkserver" in methods else "spawn")
+
+
+def _on_pool(job: Job, batches: Iterator[list], workers: int, window: int) -> Iterator[LotResult]:
+    pool = ProcessPoolExecutor(
+        max_workers=workers, mp_context=_context(), initializer=_start_worker, initargs=(job,)
+    )
+    try:
+        yield from _in_order(lambda batch: pool.submit(_pool_batch, batch), batches, window)
+    finally:
+        pool.shutdown(wait=True, cancel_futures=True)
+
+
+def _in_order(
+    submit: Callable[[list], Future], batches: Iterator[list], window: int
+) -> Iterator[LotResult]:
+    """Submit batches, at most ``window`` in flight, and yield their results in order."""
+    pending: deque = deque()
+    for batch in batches:
+        pending.append(submit(batch))
+        while len(pending) >= window:
+            yield from pending.popleft().result()
+    while pending:
+        yield from pending.popleft().result()
+
+
+# --------------------------------------------------------------------------------------------
+# a Dask cluster
+
+
+def _on_dask(
+    job: Job, batches: Iterator[list], address: str, workers: int, window: int
+) -> Iterator[LotResult]:
+    try:
+        from distributed import Client, LocalCluster
+    except ImportError:
+        raise BgrError(
+            "--dask needs Dask's distributed scheduler, an optional extra: pip install 'bgr[dask]'"
+        ) from None
+    cluster = None
+    try:
+        if address == "local":
+            cluster = LocalCluster(
+                n_workers=workers,
+                threads_per_worker=1,
+                processes=True,
+                dashboard_address=None,
+                silence_logs=40,  # logging.ERROR: the cluster's chatter is not the user's
+            )
+            client = Client(cluster)
+        else:
+            client = Client(address, timeout="15s")
+    except (OSError, TimeoutError, ValueError) as e:
+        if cluster is not None:
+            cluster.close()
+        raise BgrError(
+            Diagnostic(
+                "",
+                0,
+                0,
+                f"--dask {address}: cannot reach a Dask scheduler there ({str(e)[:120]})",
+                "start one with 'dask scheduler' and workers with 'dask worker ADDRESS', or "
+                "give --dask local for a cluster on this machine",
+            )
+        ) from None
+    window = max(window, 4 * len(client.scheduler_info().get("workers", {})) or window)
+    try:
+        shared = client.scatter(job, broadcast=True)
+        yield from _in_order(
+            lambda batch: client.submit(derive_batch, shared, batch, pure=False), batches, window
+        )
+    finally:
+        client.close()
+        if cluster is not None:
+            cluster.close()
+
+
+def default_workers() -> int:
+    """The cores this process may use (``--workers 0`` asks for them)."""
+    try:
+        return len(os.sched_getaffinity(0))
+    except AttributeError:  # pragma: no cover - macOS, Windows
+        return os.cpu_count() or 1
