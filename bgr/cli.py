@@ -119,6 +119,21 @@ def build_parser() -> argparse.ArgumentParser:
         help="glTF: store repeated parts once with EXT_mesh_gpu_instancing (smaller files; "
         "the extension is then required, so readers without it refuse the file)",
     )
+    parallel = derive.add_argument_group("many lots")
+    parallel.add_argument(
+        "--workers",
+        type=_count,
+        default=1,
+        metavar="N",
+        help="derive lots on N local processes (0: one per core; default 1, this process); the "
+        "files are the same bytes whatever N",
+    )
+    parallel.add_argument(
+        "--dask",
+        metavar="ADDRESS",
+        help="derive lots on a Dask cluster: a scheduler address (tcp://host:8786), or 'local' "
+        "for a cluster of --workers processes on this machine (needs pip install 'bgr[dask]')",
+    )
     add_budget_options(derive)
     derive.add_argument(
         "--strict",
@@ -521,9 +536,20 @@ def _whole(text: str) -> int:
     return int(text)
 
 
+def _count(text: str) -> int:
+    """An argparse type: a whole number of at least 0 (a count of workers)."""
+    value = _whole(text)
+    if value < 0:
+        raise argparse.ArgumentTypeError(f"{text[:40]!r} is not 0 or more")
+    return value
+
+
 def cmd_derive(args) -> int:
-    from .formats import write
-    from .interpreter.derive import derive
+    import numpy as np
+
+    from .formats.sinks import open_sink, streams
+    from .interpreter.batch import default_workers, derive_lots
+    from .interpreter.derive import prepare, site_of
 
     if args.output in (None, "-") and args.format != "json":
         print(
@@ -543,29 +569,71 @@ def cmd_derive(args) -> int:
     if isinstance(limits, str):
         print(f"bgr derive: {limits}", file=sys.stderr)
         return EXIT_USAGE
+    workers = args.workers or default_workers()
     grammar = load(Path(args.file), path=args.file, allow_paths=args.allow_path)
-    result = derive(
-        grammar, seed=args.seed, attrs=attrs, lot=args.lot, strict=args.strict, **limits
+    output = "-" if args.output in (None, "-") else args.output
+    fmt = args.format if output != "-" else "json"
+    job, lots, warnings = prepare(
+        grammar,
+        seed=args.seed,
+        attrs=attrs,
+        lot=args.lot,
+        strict=args.strict,
+        # a streamed file holds one lot at a time: the shape and triangle budgets are per lot
+        per_lot=streams(output, fmt, args.group_by),
+        **limits,
     )
-    for warning in result.warnings:
-        print(warning.render(), file=sys.stderr)
-    if args.output in (None, "-"):
-        write(result.terminals, Path("-"), seed=args.seed, attrs=result.attrs, fmt="json")
-    else:
-        write(
-            result.terminals,
-            Path(args.output),
+    shown: set[tuple] = set()
+
+    def show(items, bar=None) -> None:
+        """Each warning once, above the progress bar."""
+        for d in items:
+            key = (d.path, d.line, d.column, d.message)
+            if key not in shown:
+                shown.add(key)
+                (bar.write if bar is not None else print)(d.render(), file=sys.stderr)
+
+    show(warnings.items)
+    with (
+        open_sink(
+            output,
             seed=args.seed,
-            attrs=result.attrs,
-            fmt=args.format,
+            attrs=job.values,
+            fmt=fmt,
+            site=site_of(lots),
+            grammar=str(grammar.path or ""),
             gltf={"group_by": args.group_by, "instancing": "auto" if args.instancing else False},
-        )
+            lot_origins=np.array([lot.shape.origin for lot in lots]),
+        ) as sink,
+        _progress(len(lots), output) as bar,
+    ):
+        for result in derive_lots(job, lots, workers=workers, dask=args.dask):
+            show(result.warnings, bar)
+            sink.add(result.table)
+            bar.update()
+    if output != "-":
+        several = f" on {len(lots):,} lots" if len(lots) > 1 else ""
         print(
-            f"{args.output}: {len(result):,} terminals, {result.terminals.triangle_count():,} "
-            "triangles",
+            f"{args.output}: {sink.terminals:,} terminals, {sink.triangles:,} triangles{several}",
             file=sys.stderr,
         )
     return EXIT_OK
+
+
+def _progress(lots: int, output: str):
+    """A bar of lots done, their rate and the time left, on a terminal when there are several
+    (and standard output is not the file being written)."""
+    from tqdm import tqdm
+
+    return tqdm(
+        total=lots,
+        unit="lot",
+        desc="deriving",
+        disable=lots < 2 or not sys.stderr.isatty() or output == "-",
+        file=sys.stderr,
+        leave=False,
+        dynamic_ncols=True,
+    )
 
 
 def cmd_infer(args) -> int:

@@ -38,7 +38,7 @@ import numpy as np
 
 from bgr.grammar.errors import BgrError, Diagnostic
 from bgr.grammar.paths import read_input
-from bgr.interpreter.terminals import TerminalTable
+from bgr.interpreter.terminals import TerminalTable, lot_tables
 
 from .meshes import bake, cross, unit_normals
 
@@ -223,10 +223,13 @@ def lots_of(table: TerminalTable, attrs: dict) -> list[dict]:
     return table.lots
 
 
-def plan(table: TerminalTable, tris: Triangles, lots: list[dict]) -> list[list[CityObjectPlan]]:
-    """Per lot, its Building first, then its BuildingParts (see the module's docstring)."""
+def plan(
+    table: TerminalTable, tris: Triangles, lots: list[dict], taken: set[str] | None = None
+) -> list[list[CityObjectPlan]]:
+    """Per lot, its Building first, then its BuildingParts (see the module's docstring).
+    ``taken``: the object ids the file already holds (a file written lot by lot)."""
     starts = np.searchsorted(tris.row, [first for first, _ in _ranges(lots)] + [len(table)])
-    taken: set[str] = set()
+    taken = set() if taken is None else taken
     out = []
     for i, lot in enumerate(lots):
         name = _unique(str(lot.get("name") or f"lot-{i}"), taken)
@@ -380,7 +383,10 @@ def _objects(objs: list[CityObjectPlan], tris: Triangles, grid: Grid) -> tuple[s
     """(the CityObjects member's JSON text, vertices) of some objects: the vertices their
     triangles use, each once.  The large arrays are written as text directly."""
     used = np.concatenate([o.triangles for o in objs]) if objs else np.zeros(0, np.int64)
-    vertices, inverse = unique_rows(tris.mm[used].reshape(-1, 3) - grid.low)
+    points = tris.mm[used].reshape(-1, 3) - grid.low
+    low = points.min(axis=0) if len(points) else np.zeros(3, np.int64)
+    vertices, inverse = unique_rows(points - low)  # it packs numbers >= 0
+    vertices = vertices + low
     index = inverse.reshape(-1, 3)
     items, at = [], 0
     for o in objs:
@@ -442,18 +448,51 @@ def write_cityjson(table: TerminalTable, stream: BinaryIO, *, seed: int, attrs: 
 
 
 def write_cityjsonseq(table: TerminalTable, stream: BinaryIO, *, seed: int, attrs: dict) -> None:
-    """CityJSON Text Sequences: a first line that is a CityJSON object with no objects and no
-    vertices (its transform and metadata hold for every line), then one ``CityJSONFeature`` per
-    Building (with its parts), each with its own vertices."""
-    tris, buildings, grid, head = _prepare(table, attrs)
-    stream.write(f'{head},"CityObjects":{{}},"vertices":[]}}\n'.encode())
-    for objs in buildings:
-        objects, vertices = _objects(objs, tris, grid)
-        text = (
-            f'{{"type":"CityJSONFeature","id":{_dumps(objs[0].id)},"CityObjects":{objects},'
-            f'"vertices":{_rows_text(vertices, "[%d,%d,%d]")}}}\n'
-        )
-        stream.write(text.encode("utf-8"))
+    """CityJSON Text Sequences (:class:`SequenceWriter`), the table's lots one by one."""
+    writer = SequenceWriter(stream, site=table.site)
+    for part in lot_tables(table):
+        writer.add(part, attrs)
+
+
+class SequenceWriter:
+    """CityJSON Text Sequences written as lots come: a first line that is a CityJSON object
+    with no objects and no vertices, then one ``CityJSONFeature`` per Building (with its
+    parts), each with its own vertices.
+
+    The first line's ``transform`` holds for every line, so it is fixed before any lot is seen:
+    it translates by the site's origin (0, 0, 0 without a site) and vertices are millimetres
+    from there (negative where a building lies west, south or below it).  The metadata names
+    the CRS but leaves out ``geographicalExtent``, which only the last lot would settle (it is
+    optional).  Object ids stay unique across the file (``-2``, ``-3``... as in one document).
+    """
+
+    def __init__(self, stream: BinaryIO, *, site: dict | None) -> None:
+        self.stream = stream
+        origin = [float(v) for v in site["origin"]] if site else [0.0, 0.0, 0.0]
+        self.grid = Grid(np.zeros(3, dtype=np.int64), origin)
+        self.taken: set[str] = set()
+        head: dict[str, Any] = {
+            "type": "CityJSON",
+            "version": VERSION,
+            "transform": self.grid.transform(),
+        }
+        crs = reference_system(site)
+        if crs:
+            head["metadata"] = {"referenceSystem": crs}
+        stream.write(f'{_dumps(head)[:-1]},"CityObjects":{{}},"vertices":[]}}\n'.encode())
+
+    def add(self, table: TerminalTable, attrs: dict) -> None:
+        """Write the Buildings of a table's lots (a table without lots is one, ``lot-0``)."""
+        table.freeze()
+        lots = lots_of(table, attrs)
+        tris = triangles(table, lots)
+        for objs in plan(table, tris, lots, self.taken):
+            objects, vertices = _objects(objs, tris, self.grid)
+            text = (
+                f'{{"type":"CityJSONFeature","id":{_dumps(objs[0].id)},"CityObjects":{objects},'
+                f'"vertices":{_rows_text(vertices, "[%d,%d,%d]")}}}\n'
+            )
+            self.stream.write(text.encode("utf-8"))
 
 
 # --------------------------------------------------------------------------------------------

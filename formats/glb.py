@@ -28,175 +28,38 @@ the output is a pure function of the table: writing the same table twice gives i
 from __future__ import annotations
 
 import base64
+import io
 import json
+import shutil
 import struct
+import tempfile
 from dataclasses import dataclass
 from typing import BinaryIO
 
 import numpy as np
 
 from bgr.grammar.errors import BgrError
-from bgr.interpreter.terminals import TerminalTable
+from bgr.interpreter.terminals import TerminalTable, lot_tables
 
+from .instancing import CORNER_BYTES, INSTANCE_BYTES, plan, quaternions
 from .materials import Materials, materials_of
-from .meshes import (
-    MeshPool,
-    bounds,
-    det3,
-    face_offsets,
-    orthonormal,
-    place_corners,
-    shape_order,
-    unit_normals,
-)
+from .meshes import MeshPool, bounds, face_offsets, place_corners, unit_normals
 from .terminal_json import plain
 
 INSTANCING = "EXT_mesh_gpu_instancing"
 FLOAT, ARRAY_BUFFER = 5126, 34962
-CORNER_BYTES = 24  # float32 position + normal per triangle corner
-INSTANCE_BYTES = 40  # float32 translation (12) + rotation quaternion (16) + scale (12)
-# JSON added by one instanced group (a mesh, a node, 5 accessors, 5 bufferViews): about 870
-# bytes measured, more with long names; the decision only needs the right order of magnitude
-GROUP_OVERHEAD = 1000
-
-
-@dataclass
-class Plan:
-    baked: np.ndarray  # terminal rows baked to world space: by material, mesh shape, table order
-    groups: list[tuple[int, int, np.ndarray]]  # instanced (mesh id, material, rows in table order)
-    scale: (
-        np.ndarray
-    )  # (N, 3) instance scales: the size, with 1 on axes where the mesh is flat at 0
-
-
-def plan(
-    table: TerminalTable,
-    pool: MeshPool,
-    mats: Materials,
-    instancing: str | bool = "auto",
-    major: np.ndarray | None = None,
-) -> Plan:
-    """Which terminals to instance.
-
-    A terminal can be instanced when its axes are orthonormal and right-handed (the rotation is a
-    quaternion) and every size is positive, or zero along an axis where its unit mesh is flat at 0
-    (a quad's z): there the scale is written as 1, which places the same vertices and keeps the
-    normal matrix invertible.  A (mesh, material) group is instanced when
-    ``stored once + 40 bytes per instance + JSON`` is smaller than baking every copy
-    (``instancing="auto"``); ``True`` instances every group that can be, ``False`` none.
-    """
-    n = len(table)
-    mesh = table.mesh.astype(np.int64)
-    size = table.size
-    flat = pool.flat_at_zero()[mesh] if n else np.zeros((0, 3), dtype=bool)
-    scale = np.where((size == 0.0) & flat, 1.0, size)
-    eligible = (
-        orthonormal(table.axes)
-        & (det3(table.axes) > 0)
-        & (scale > 0).all(axis=1)
-        & (pool.fcount[mesh] > 0)
-    )
-    if instancing is False or instancing == "never" or n == 0:
-        eligible[:] = False
-
-    n_mesh = max(len(pool.vcount), 1)
-    if major is None:  # the file's grouping of rows (scene group and material); else material
-        major = mats.index.astype(np.int64)
-    key = major * n_mesh + mesh
-    keys, counts = np.unique(key[eligible], return_counts=True)
-    faces = pool.fcount[keys % n_mesh]
-    stored = faces * 3 * CORNER_BYTES
-    if instancing is True or instancing == "always":
-        chosen = keys
-    else:
-        chosen = keys[
-            (counts >= 2) & (stored + counts * INSTANCE_BYTES + GROUP_OVERHEAD < counts * stored)
-        ]
-
-    instanced = eligible & np.isin(key, chosen)
-    groups = []
-    if chosen.size:
-        rows = np.flatnonzero(instanced)
-        order = np.argsort(key[rows], kind="stable")
-        rows = rows[order]
-        cuts = np.flatnonzero(np.diff(key[rows])) + 1
-        for grp in np.split(rows, cuts):
-            groups.append((int(mesh[grp[0]]), int(mats.index[grp[0]]), grp))
-    baked = np.flatnonzero(~instanced)
-    baked = shape_order(table, baked, pool, major[baked])
-    return Plan(baked=baked, groups=groups, scale=scale)
-
-
-def quaternions(axes: np.ndarray) -> np.ndarray:
-    """(n, 4) unit quaternions (x, y, z, w), w >= 0, of rotations whose matrix columns are the
-    rows of ``axes`` (orthonormal, right-handed)."""
-    R = axes.transpose(0, 2, 1)
-    m00, m11, m22 = R[:, 0, 0], R[:, 1, 1], R[:, 2, 2]
-    q = np.empty((len(R), 4))
-    # Shepperd's method: take the largest of w, x, y, z as the pivot, for accuracy
-    pivots = np.stack([m00 + m11 + m22, m00, m11, m22], axis=1).argmax(axis=1)
-    for case in range(4):
-        sel = pivots == case
-        if not sel.any():
-            continue
-        r = R[sel]
-        a, b, c = r[:, 0, 0], r[:, 1, 1], r[:, 2, 2]
-        if case == 0:
-            s = np.sqrt(1.0 + a + b + c) * 2
-            q[sel] = np.stack(
-                [
-                    (r[:, 2, 1] - r[:, 1, 2]) / s,
-                    (r[:, 0, 2] - r[:, 2, 0]) / s,
-                    (r[:, 1, 0] - r[:, 0, 1]) / s,
-                    0.25 * s,
-                ],
-                axis=1,
-            )
-        elif case == 1:
-            s = np.sqrt(1.0 + a - b - c) * 2
-            q[sel] = np.stack(
-                [
-                    0.25 * s,
-                    (r[:, 0, 1] + r[:, 1, 0]) / s,
-                    (r[:, 0, 2] + r[:, 2, 0]) / s,
-                    (r[:, 2, 1] - r[:, 1, 2]) / s,
-                ],
-                axis=1,
-            )
-        elif case == 2:
-            s = np.sqrt(1.0 + b - a - c) * 2
-            q[sel] = np.stack(
-                [
-                    (r[:, 0, 1] + r[:, 1, 0]) / s,
-                    0.25 * s,
-                    (r[:, 1, 2] + r[:, 2, 1]) / s,
-                    (r[:, 0, 2] - r[:, 2, 0]) / s,
-                ],
-                axis=1,
-            )
-        else:
-            s = np.sqrt(1.0 + c - a - b) * 2
-            q[sel] = np.stack(
-                [
-                    (r[:, 0, 2] + r[:, 2, 0]) / s,
-                    (r[:, 1, 2] + r[:, 2, 1]) / s,
-                    0.25 * s,
-                    (r[:, 1, 0] - r[:, 0, 1]) / s,
-                ],
-                axis=1,
-            )
-    q /= np.linalg.norm(q, axis=1, keepdims=True)
-    q[q[:, 3] < 0] *= -1
-    return q
+__all__ = ["Scene", "build", "write_glb", "write_gltf", "quaternions", "plan", "recentre"]
 
 
 class _Builder:
-    """float32 blocks in one preallocated little-endian buffer, and a bufferView per accessor
-    (glTF wants a ``byteStride`` when accessors share a view; one view each needs none)."""
+    """float32 blocks of one part of the file's buffer, and a bufferView per accessor (glTF
+    wants a ``byteStride`` when accessors share a view; one view each needs none).  ``base``:
+    the bytes, views and accessors the file holds before this part."""
 
-    def __init__(self, nbytes: int) -> None:
+    def __init__(self, nbytes: int, base: tuple[int, int, int] = (0, 0, 0)) -> None:
         self.bin = np.zeros(nbytes, dtype=np.uint8)
         self.offset = 0
+        self.byte_base, self.view_base, self.accessor_base = base
         self.views: list[dict] = []
         self.accessors: list[dict] = []
 
@@ -216,12 +79,12 @@ class _Builder:
     ) -> int:
         """A view on ``data`` (rows of a block starting at byte ``start``) and its accessor,
         with min/max if ``bounded`` (POSITION needs them)."""
-        view = {"buffer": 0, "byteOffset": start, "byteLength": int(data.nbytes)}
+        view = {"buffer": 0, "byteOffset": self.byte_base + start, "byteLength": int(data.nbytes)}
         if target is not None:
             view["target"] = target
         self.views.append(view)
         acc = {
-            "bufferView": len(self.views) - 1,
+            "bufferView": self.view_base + len(self.views) - 1,
             "componentType": FLOAT,
             "count": len(data),
             "type": f"VEC{data.shape[1]}",
@@ -230,7 +93,7 @@ class _Builder:
             lo, hi = bounds(data)
             acc["min"], acc["max"] = [float(v) for v in lo], [float(v) for v in hi]
         self.accessors.append(acc)
-        return len(self.accessors) - 1
+        return self.accessor_base + len(self.accessors) - 1
 
     def vec(
         self, values: np.ndarray, target: int | None = ARRAY_BUFFER, bounded: bool = False
@@ -244,10 +107,19 @@ class _Builder:
 def recentre(table: TerminalTable, limit: float = 4096.0) -> np.ndarray:
     """A whole-metre offset to subtract from positions (and put back as the root node's
     translation) when the scene lies far from the origin, where float32 would lose millimetres;
-    else zeros."""
-    if len(table) == 0 or np.abs(table.origin).max() <= limit:
+    else zeros.  Taken from the lots' origins when the table has lots: a run that writes lots
+    as they are derived knows those before any terminal (:func:`recentre_points`)."""
+    if table.lots:
+        return recentre_points(np.array([lot["origin"] for lot in table.lots]), limit)
+    return recentre_points(table.origin, limit)
+
+
+def recentre_points(points: np.ndarray, limit: float = 4096.0) -> np.ndarray:
+    """The whole-metre centre of ``points`` (n, 3) when one lies beyond ``limit``, else zeros."""
+    points = np.asarray(points, dtype=np.float64).reshape(-1, 3)
+    if len(points) == 0 or np.abs(points).max() <= limit:
         return np.zeros(3)
-    return np.round((table.origin.min(axis=0) + table.origin.max(axis=0)) / 2) + 0.0
+    return np.round((points.min(axis=0) + points.max(axis=0)) / 2) + 0.0
 
 
 GROUPINGS = ("lot", "label", "none")
@@ -291,6 +163,363 @@ def lot_rows(table: TerminalTable) -> np.ndarray:
     return out
 
 
+class MaterialIndex:
+    """The file's materials, in first-use order over every part added: each part's
+    :class:`Materials` gets the file's material numbers as its ``index``."""
+
+    def __init__(self) -> None:
+        self.numbers: dict[tuple, int] = {}
+        self.names: list[str | None] = []
+        self.rgb8: list[np.ndarray] = []
+
+    def __len__(self) -> int:
+        return len(self.names)
+
+    def of(self, table: TerminalTable) -> Materials:
+        local = materials_of(table)
+        number = np.empty(len(local), dtype=np.int64)
+        for k, name in enumerate(local.names):
+            key = (name, *(int(c) for c in local.rgb8[k]))
+            if key not in self.numbers:
+                self.numbers[key] = len(self.names)
+                self.names.append(name)
+                self.rgb8.append(local.rgb8[k])
+            number[k] = self.numbers[key]
+        local.index = number[local.index] if len(local.index) else local.index
+        return local
+
+    def all(self) -> Materials:
+        """Every material so far, with its display label (which needs all of them)."""
+        rgb8 = np.array(self.rgb8, dtype=np.uint8).reshape(-1, 3)
+        per_name: dict[str | None, int] = {}
+        for n in self.names:
+            per_name[n] = per_name.get(n, 0) + 1
+        labels = []
+        for k, n in enumerate(self.names):
+            hx = "#" + "".join(f"{int(c):02x}" for c in rgb8[k])
+            labels.append(hx if n is None else (n if per_name[n] == 1 else f"{n} {hx}"))
+        return Materials(np.zeros(0, np.int64), rgb8, list(self.names), labels)
+
+
+SPOOL_MEMORY = 1 << 20  # bytes a spool holds in memory before it moves to a temporary file
+
+
+class _Spool:
+    """A JSON array's items (or the binary buffer) written to a temporary file as they come:
+    held in memory up to a few megabytes, on disk beyond, removed when closed."""
+
+    def __init__(self, folder: str | None, memory: int = SPOOL_MEMORY) -> None:
+        # closed by close(): a spool lives as long as the Scene that owns it
+        self.file = tempfile.SpooledTemporaryFile(max_size=memory, dir=folder)  # noqa: SIM115
+        self.count = 0
+        self.nbytes = 0
+
+    def item(self, value: dict) -> None:
+        text = (b"," if self.count else b"") + _json_bytes(value)
+        self.file.write(text)
+        self.count += 1
+        self.nbytes += len(text)
+
+    def raw(self, data) -> None:
+        self.file.write(data)
+        self.nbytes += len(memoryview(data).cast("B"))
+
+    def copy_to(self, stream: BinaryIO) -> None:
+        self.file.seek(0)
+        shutil.copyfileobj(self.file, stream, 1 << 20)
+
+    def close(self) -> None:
+        self.file.close()
+
+
+class Scene:
+    """A glTF file built part by part — a part is one lot's terminals, or a whole table — so
+    that a city can be written as its lots are derived: the nodes, meshes, accessors and views
+    of each part and its binary data go to spools (:class:`_Spool`) and the part is dropped;
+    :meth:`write_glb` puts the file together at the end.  Only the root node and the materials
+    stay in memory.
+
+    Writing a table, and writing its lots one by one (:func:`lot_tables`), give the same bytes:
+    :func:`build` and :func:`write_glb` add a table with lots lot by lot too.  ``group_by``
+    "label" and "none" gather several lots under one node, so they take one part, the whole
+    table.  ``shift``: see :func:`recentre`.  ``folder``: where spools that outgrow memory go
+    (the output's folder; None: the system's temporary folder).
+    """
+
+    def __init__(
+        self,
+        *,
+        seed: int,
+        attrs: dict,
+        grammar: str = "",
+        site: dict | None = None,
+        instancing: str | bool = False,
+        group_by: str = "lot",
+        shift: np.ndarray | None = None,
+        folder: str | None = None,
+    ) -> None:
+        if group_by not in GROUPINGS:
+            raise BgrError(f"unknown grouping '{group_by}': use one of {', '.join(GROUPINGS)}")
+        self.seed, self.attrs, self.instancing, self.group_by = seed, attrs, instancing, group_by
+        self.shift = np.zeros(3) if shift is None else np.asarray(shift, dtype=np.float64)
+        self.materials = MaterialIndex()
+        self.used: set[int] = set()  # materials some primitive uses
+        self.instanced = False
+        self.parts = 0
+        self.root: dict = {"name": "bgr", "children": []}
+        if self.shift.any():
+            self.root["translation"] = self.shift.tolist()
+        meta = TerminalTable(site=site, grammar=grammar)
+        self.root["extras"] = root_extras(meta, seed, attrs)
+        self.spools = {k: _Spool(folder) for k in ("nodes", "meshes", "accessors", "views")}
+        self.spools["bin"] = _Spool(folder, memory=16 << 10)  # the bulk: on disk at once
+
+    def close(self) -> None:
+        for spool in self.spools.values():
+            spool.close()
+
+    def __enter__(self) -> Scene:
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self.close()
+
+    def add(self, table: TerminalTable) -> None:
+        """Add a part: its lots' nodes (``group_by="lot"``) or its label nodes, its meshes and
+        their data.  With ``group_by`` "label" or "none" a file takes one part."""
+        table.freeze()
+        if self.group_by != "lot" and self.parts:
+            raise BgrError(f"group_by='{self.group_by}' writes one table, not several parts")
+        self.parts += 1
+        if not len(table):
+            return
+        sp = self.spools
+        pool = MeshPool.of(table)
+        mats = self.materials.of(table)
+        groups = groups_of(table, self.group_by)
+        # a row's instancing group and place in the file: its scene group first, then material
+        major = groups.of_row * max(len(self.materials), 1) + mats.index
+        p = plan(table, pool, mats, self.instancing, major)
+
+        fstart = face_offsets(table, p.baked, pool)
+        n_corner = 3 * int(fstart[-1])
+        nbytes = n_corner * CORNER_BYTES
+        for mesh_id, _, rows in p.groups:
+            nbytes += int(pool.fcount[mesh_id]) * 3 * CORNER_BYTES + len(rows) * INSTANCE_BYTES
+        b = _Builder(nbytes, (sp["bin"].nbytes, sp["views"].count, sp["accessors"].count))
+
+        # baked terminals: one primitive per (group, material), a slice of two big blocks
+        prims: list[list[dict]] = [[] for _ in groups.name]
+        if n_corner:
+            pos_at, pos_data = b.block(n_corner, 3)
+            nrm_at, nrm_data = b.block(n_corner, 3)
+            place_corners(
+                table,
+                p.baked,
+                pool,
+                pos_data.reshape(-1, 3, 3),
+                nrm_data.reshape(-1, 3, 3),
+                self.shift,
+            )
+            key = major[p.baked]
+            cuts = np.flatnonzero(np.diff(key)) + 1
+            for lo, hi in zip(
+                np.concatenate([[0], cuts]), np.concatenate([cuts, [len(key)]]), strict=True
+            ):
+                first, end = 3 * int(fstart[lo]), 3 * int(fstart[hi])
+                if end > first:
+                    row = p.baked[lo]
+                    prims[int(groups.of_row[row])].append(
+                        {
+                            "attributes": {
+                                "POSITION": b.accessor(
+                                    pos_at + first * 12, pos_data[first:end], bounded=True
+                                ),
+                                "NORMAL": b.accessor(nrm_at + first * 12, nrm_data[first:end]),
+                            },
+                            "material": int(mats.index[row]),
+                            "mode": 4,
+                        }
+                    )
+
+        nodes: list[dict] = []  # this part's; node k is number node_base + k of the file
+        node_base = 1 + sp["nodes"].count  # node 0 is the root
+        meshes: list[dict] = []
+        mesh_base = sp["meshes"].count
+
+        def new_node(node: dict, parent: dict) -> dict:
+            nodes.append(node)
+            parent.setdefault("children", []).append(node_base + len(nodes) - 1)
+            return node
+
+        lot_node: dict[int, dict] = {}
+
+        def node_of(group: int) -> dict:
+            if self.group_by == "none":
+                return self.root
+            if group not in group_node:
+                parent = self.root
+                lot = groups.lot[group]
+                if lot >= 0:
+                    if lot not in lot_node:
+                        lot_node[lot] = new_node(lot_extras(table, lot), self.root)
+                    parent = lot_node[lot]
+                group_node[group] = new_node({"name": groups.name[group]}, parent)
+            return group_node[group]
+
+        group_node: dict[int, dict] = {}
+        for group, primitives in enumerate(prims):
+            if primitives:
+                meshes.append({"name": groups.name[group], "primitives": primitives})
+                node_of(group)["mesh"] = mesh_base + len(meshes) - 1
+
+        # instanced groups (opt-in): the unit mesh once, a child node with per-instance TRS
+        names = [m.name for m in table.library.meshes]
+        labels = self.materials.all().labels if p.groups else []
+        for mesh_id, mat, rows in p.groups:
+            unit = pool.vertices[pool.voff[mesh_id] : pool.voff[mesh_id] + pool.vcount[mesh_id]]
+            faces = pool.faces[pool.foff[mesh_id] : pool.foff[mesh_id] + pool.fcount[mesh_id]]
+            corners = unit[faces]
+            normals = unit_normals(corners, fallback=(0.0, 0.0, 1.0))
+            pos = b.vec(corners.reshape(-1, 3), bounded=True)
+            nrm = b.vec(np.repeat(normals, 3, axis=0))
+            trs = {
+                "TRANSLATION": b.vec(table.origin[rows] - self.shift, None),
+                "ROTATION": b.vec(quaternions(table.axes[rows]), None),
+                "SCALE": b.vec(p.scale[rows], None),
+            }
+            name = f"{names[mesh_id]} {labels[mat]}"
+            meshes.append(
+                {
+                    "name": name,
+                    "primitives": [
+                        {"attributes": {"POSITION": pos, "NORMAL": nrm}, "material": mat, "mode": 4}
+                    ],
+                }
+            )
+            new_node(
+                {
+                    "name": name,
+                    "mesh": mesh_base + len(meshes) - 1,
+                    "extensions": {INSTANCING: {"attributes": trs}},
+                },
+                node_of(int(groups.of_row[rows[0]])),
+            )
+        assert b.offset == nbytes
+        self.instanced |= bool(p.groups)
+        self.used.update(prim["material"] for mesh in meshes for prim in mesh["primitives"])
+        for node in nodes:
+            sp["nodes"].item(node)
+        for mesh in meshes:
+            sp["meshes"].item(mesh)
+        for accessor in b.accessors:
+            sp["accessors"].item(accessor)
+        for view in b.views:
+            sp["views"].item(view)
+        sp["bin"].raw(b.bin.data)
+
+    def _pieces(self) -> list[bytes | _Spool]:
+        """The JSON document as text pieces and spools, in order."""
+        sp = self.spools
+        head: dict = {
+            "asset": {
+                "version": "2.0",
+                "generator": f"bgr {_version()}",
+                "extras": {"bgr": 1, "seed": self.seed, "attrs": self.attrs},
+            }
+        }
+        if self.instanced:  # a reader without the extension must refuse the file
+            head["extensionsUsed"] = [INSTANCING]
+            head["extensionsRequired"] = [INSTANCING]
+        head["scene"] = 0
+        head["scenes"] = [{"name": "bgr", "nodes": [0]}]
+        root = dict(self.root)
+        if not root["children"]:
+            del root["children"]
+        pieces: list[bytes | _Spool] = [_json_bytes(head)[:-1] + b',"nodes":[' + _json_bytes(root)]
+        if sp["nodes"].count:
+            pieces += [b",", sp["nodes"]]
+        pieces.append(b"]")
+        if sp["meshes"].count:
+            pieces += [b',"meshes":[', sp["meshes"], b"]"]
+        if self.used:
+            mats = self.materials.all()
+            materials = [
+                {
+                    "name": mats.labels[k],
+                    "pbrMetallicRoughness": {
+                        "baseColorFactor": mats.linear(k) + [1.0],
+                        "metallicFactor": 0.0,
+                        "roughnessFactor": 0.8,
+                    },
+                    "doubleSided": True,
+                    "extras": {"color": mats.hex(k), "material": mats.names[k]},
+                }
+                for k in range(len(mats))
+            ]
+            pieces.append(b',"materials":' + _json_bytes(materials))
+        if sp["accessors"].count:
+            pieces += [b',"accessors":[', sp["accessors"], b'],"bufferViews":[', sp["views"]]
+            pieces.append(b'],"buffers":' + _json_bytes([{"byteLength": sp["bin"].nbytes}]))
+        pieces.append(b"}")
+        return pieces
+
+    def write_glb(self, stream: BinaryIO) -> None:
+        """The binary glTF: header, JSON chunk (space-padded), BIN chunk."""
+        pieces = self._pieces()
+        length = sum(p.nbytes if isinstance(p, _Spool) else len(p) for p in pieces)
+        pad = -length % 4
+        nbin = self.spools["bin"].nbytes  # a multiple of 4: every block is float32
+        total = 12 + 8 + length + pad + (8 + nbin if nbin else 0)
+        stream.write(struct.pack("<4sII", b"glTF", 2, total))
+        stream.write(struct.pack("<II", length + pad, 0x4E4F534A))
+        for piece in pieces:
+            piece.copy_to(stream) if isinstance(piece, _Spool) else stream.write(piece)
+        stream.write(b" " * pad)
+        if nbin:
+            stream.write(struct.pack("<II", nbin, 0x004E4942))
+            self.spools["bin"].copy_to(stream)
+
+    def document(self) -> tuple[dict, bytes]:
+        """The glTF JSON as Python data and the binary buffer (for .gltf, and tests)."""
+        text = io.BytesIO()
+        for piece in self._pieces():
+            piece.copy_to(text) if isinstance(piece, _Spool) else text.write(piece)
+        data = io.BytesIO()
+        self.spools["bin"].copy_to(data)
+        return json.loads(text.getvalue()), data.getvalue()
+
+
+def scene_of(
+    table: TerminalTable,
+    *,
+    seed: int,
+    attrs: dict,
+    instancing: str | bool = False,
+    group_by: str = "lot",
+    folder: str | None = None,
+) -> Scene:
+    """A table's :class:`Scene`, lot by lot when it groups by lot."""
+    table.freeze()
+    scene = Scene(
+        seed=seed,
+        attrs=attrs,
+        grammar=getattr(table, "grammar", "") or "",
+        site=table.site,
+        instancing=instancing,
+        group_by=group_by,
+        shift=recentre(table),
+        folder=folder,
+    )
+    try:
+        for part in lot_tables(table) if group_by == "lot" else [table]:
+            scene.add(part)
+    except BaseException:
+        scene.close()
+        raise
+    return scene
+
+
 def build(
     table: TerminalTable,
     *,
@@ -298,8 +527,8 @@ def build(
     attrs: dict,
     instancing: str | bool = False,
     group_by: str = "lot",
-) -> tuple[dict, np.ndarray]:
-    """The glTF JSON document and its binary buffer (uint8) for a table.
+) -> tuple[dict, bytes]:
+    """The glTF JSON document and its binary buffer for a table.
 
     The scene is one root node ``bgr`` (extras: grammar, seed, attrs, bgr version, and the CRS
     and origin of geographic lots); under it, with ``group_by="lot"``, a node per lot named by
@@ -309,159 +538,8 @@ def build(
     shared by the whole file.  ``instancing``: see :func:`plan` (off by default: every reader
     then sees every triangle).
     """
-    if group_by not in GROUPINGS:
-        raise BgrError(f"unknown grouping '{group_by}': use one of {', '.join(GROUPINGS)}")
-    table.freeze()
-    pool = MeshPool.of(table)
-    mats = materials_of(table)
-    groups = groups_of(table, group_by)
-    n_groups = len(groups.name)
-    # a row's instancing group and place in the file: its scene group first, then material
-    major = groups.of_row * max(len(mats), 1) + mats.index
-    p = plan(table, pool, mats, instancing, major)
-
-    fstart = face_offsets(table, p.baked, pool)
-    n_corner = 3 * int(fstart[-1])
-    nbytes = n_corner * CORNER_BYTES
-    for mesh_id, _, rows in p.groups:
-        nbytes += int(pool.fcount[mesh_id]) * 3 * CORNER_BYTES + len(rows) * INSTANCE_BYTES
-    b = _Builder(nbytes)
-    shift = recentre(table)
-
-    # baked terminals: one primitive per (group, material), a slice of two big blocks
-    prims: list[list[dict]] = [[] for _ in range(n_groups)]
-    if n_corner:
-        pos_at, pos_data = b.block(n_corner, 3)
-        nrm_at, nrm_data = b.block(n_corner, 3)
-        place_corners(
-            table, p.baked, pool, pos_data.reshape(-1, 3, 3), nrm_data.reshape(-1, 3, 3), shift
-        )
-        key = major[p.baked]
-        cuts = np.flatnonzero(np.diff(key)) + 1
-        for lo, hi in zip(
-            np.concatenate([[0], cuts]), np.concatenate([cuts, [len(key)]]), strict=True
-        ):
-            first, end = 3 * int(fstart[lo]), 3 * int(fstart[hi])
-            if end > first:
-                row = p.baked[lo]
-                prims[int(groups.of_row[row])].append(
-                    {
-                        "attributes": {
-                            "POSITION": b.accessor(
-                                pos_at + first * 12, pos_data[first:end], bounded=True
-                            ),
-                            "NORMAL": b.accessor(nrm_at + first * 12, nrm_data[first:end]),
-                        },
-                        "material": int(mats.index[row]),
-                        "mode": 4,
-                    }
-                )
-
-    meshes: list[dict] = []
-    nodes: list[dict] = [{"name": "bgr", "children": []}]
-    if shift.any():
-        nodes[0]["translation"] = shift.tolist()
-    nodes[0]["extras"] = root_extras(table, seed, attrs)
-    lot_node: dict[int, dict] = {}
-
-    def parent_of(group: int) -> dict:
-        lot = groups.lot[group]
-        if lot < 0:
-            return nodes[0]
-        if lot not in lot_node:
-            lot_node[lot] = node = lot_extras(table, lot)
-            nodes.append(node)
-            nodes[0]["children"].append(len(nodes) - 1)
-        return lot_node[lot]
-
-    group_node: dict[int, dict] = {}
-
-    def node_of(group: int) -> dict:
-        if group not in group_node:
-            if group_by == "none":
-                group_node[group] = nodes[0]
-            else:
-                parent = parent_of(group)
-                nodes.append({"name": groups.name[group]})
-                parent.setdefault("children", []).append(len(nodes) - 1)
-                group_node[group] = nodes[-1]
-        return group_node[group]
-
-    for group in range(n_groups):
-        if prims[group]:
-            meshes.append({"name": groups.name[group], "primitives": prims[group]})
-            node_of(group)["mesh"] = len(meshes) - 1
-
-    # instanced groups (opt-in): the unit mesh once, a child node with per-instance TRS
-    names = [m.name for m in table.library.meshes]
-    for mesh_id, mat, rows in p.groups:
-        unit = pool.vertices[pool.voff[mesh_id] : pool.voff[mesh_id] + pool.vcount[mesh_id]]
-        corners = unit[pool.faces[pool.foff[mesh_id] : pool.foff[mesh_id] + pool.fcount[mesh_id]]]
-        normals = unit_normals(corners, fallback=(0.0, 0.0, 1.0))
-        pos = b.vec(corners.reshape(-1, 3), bounded=True)
-        nrm = b.vec(np.repeat(normals, 3, axis=0))
-        trs = {
-            "TRANSLATION": b.vec(table.origin[rows] - shift, None),
-            "ROTATION": b.vec(quaternions(table.axes[rows]), None),
-            "SCALE": b.vec(p.scale[rows], None),
-        }
-        name = f"{names[mesh_id]} {mats.labels[mat]}"
-        meshes.append(
-            {
-                "name": name,
-                "primitives": [
-                    {"attributes": {"POSITION": pos, "NORMAL": nrm}, "material": mat, "mode": 4}
-                ],
-            }
-        )
-        parent = node_of(int(groups.of_row[rows[0]]))
-        nodes.append(
-            {
-                "name": name,
-                "mesh": len(meshes) - 1,
-                "extensions": {INSTANCING: {"attributes": trs}},
-            }
-        )
-        parent.setdefault("children", []).append(len(nodes) - 1)
-    assert b.offset == nbytes
-    if not nodes[0]["children"]:
-        del nodes[0]["children"]
-
-    gltf: dict = {
-        "asset": {
-            "version": "2.0",
-            "generator": f"bgr {_version()}",
-            "extras": {"bgr": 1, "seed": seed, "attrs": attrs},
-        }
-    }
-    if p.groups:  # a reader without the extension must refuse the file, not drop geometry
-        gltf["extensionsUsed"] = [INSTANCING]
-        gltf["extensionsRequired"] = [INSTANCING]
-    gltf["scene"] = 0
-    gltf["scenes"] = [{"name": "bgr", "nodes": [0]}]
-    gltf["nodes"] = nodes
-    if meshes:
-        gltf["meshes"] = meshes
-    used = sorted({prim["material"] for mesh in meshes for prim in mesh["primitives"]})
-    if used:
-        gltf["materials"] = [
-            {
-                "name": mats.labels[k],
-                "pbrMetallicRoughness": {
-                    "baseColorFactor": mats.linear(k) + [1.0],
-                    "metallicFactor": 0.0,
-                    "roughnessFactor": 0.8,
-                },
-                "doubleSided": True,
-                "extras": {"color": mats.hex(k), "material": mats.names[k]},
-            }
-            for k in range(len(mats))
-        ]
-    if b.accessors:
-        gltf["accessors"] = b.accessors
-        gltf["bufferViews"] = b.views
-        gltf["buffers"] = [{"byteLength": int(b.bin.nbytes)}]
-    return gltf, b.bin
+    with scene_of(table, seed=seed, attrs=attrs, instancing=instancing, group_by=group_by) as scene:
+        return scene.document()
 
 
 def root_extras(table: TerminalTable, seed: int, attrs: dict) -> dict:
@@ -496,7 +574,7 @@ def _version() -> str:
         return "0"
 
 
-def _json_bytes(gltf: dict, **layout) -> bytes:
+def _json_bytes(gltf, **layout) -> bytes:
     layout = layout or {"separators": (",", ":")}
     try:
         return json.dumps(
@@ -519,16 +597,8 @@ def write_glb(
 
     ``instancing`` and ``group_by``: see :func:`build`.
     """
-    gltf, bin_ = build(table, seed=seed, attrs=attrs, instancing=instancing, group_by=group_by)
-    text = _json_bytes(gltf)
-    text += b" " * (-len(text) % 4)
-    chunks: list[bytes | np.ndarray] = [struct.pack("<II", len(text), 0x4E4F534A), text]
-    if bin_.nbytes:
-        chunks += [struct.pack("<II", bin_.nbytes, 0x004E4942), bin_]  # already a multiple of 4
-    total = 12 + sum(len(c) if isinstance(c, bytes) else c.nbytes for c in chunks)
-    stream.write(struct.pack("<4sII", b"glTF", 2, total))
-    for c in chunks:
-        stream.write(c if isinstance(c, bytes) else c.data)
+    with scene_of(table, seed=seed, attrs=attrs, instancing=instancing, group_by=group_by) as scene:
+        scene.write_glb(stream)
 
 
 def write_gltf(
@@ -542,8 +612,8 @@ def write_gltf(
 ) -> None:
     """One self-contained .gltf: JSON with the buffer as a base64 data URI."""
     gltf, bin_ = build(table, seed=seed, attrs=attrs, instancing=instancing, group_by=group_by)
-    if bin_.nbytes:
+    if bin_:
         gltf["buffers"][0]["uri"] = "data:application/octet-stream;base64," + base64.b64encode(
-            bin_.tobytes()
+            bin_
         ).decode("ascii")
     stream.write(_json_bytes(gltf, indent=1) + b"\n")

@@ -9,12 +9,14 @@ from __future__ import annotations
 import contextlib
 import gc
 import json
+import tempfile
+from collections.abc import Callable
 from typing import BinaryIO, TextIO
 
 import numpy as np
 
 from bgr.grammar.errors import BgrError
-from bgr.interpreter.terminals import TerminalTable
+from bgr.interpreter.terminals import TerminalTable, lot_tables
 
 from .meshes import srgb8
 
@@ -96,20 +98,56 @@ LOT_KEYS = ("path", "name", "origin", "axes", "size")
 
 def dumps(table: TerminalTable, *, seed: int, attrs: dict) -> str:
     """The whole document as text (ends with a newline)."""
-    with _no_gc():
-        return _document(table, seed, attrs)
+    pieces: list[str] = []
+    writer = TerminalListWriter(pieces.append, seed=seed, attrs=attrs)
+    for part in lot_tables(table):
+        writer.add(part)
+    writer.finish()
+    return "".join(pieces)
 
 
-def _document(table: TerminalTable, seed: int, attrs: dict) -> str:
-    head = (
-        f'{{\n  "bgr": 1,\n  "seed": {_dumps(seed)},\n  "attrs": {_dumps(attrs)},\n  "terminals": ['
-    )
-    rows = ",\n".join(["    " + _dumps(t) for t in terminal_dicts(table)])
-    lots = ",\n".join(
-        ["    " + _dumps({k: lot[k] for k in LOT_KEYS if k in lot}) for lot in table.lots]
-    )
-    tail = ',\n  "lots": [\n' + lots + "\n  ]\n}\n" if lots else "\n}\n"
-    return head + ("\n" + rows + "\n  ]" if rows else "]") + tail
+class TerminalListWriter:
+    """The terminal list written as lots come: the head and each lot's terminals at once, the
+    ``lots`` array (which follows the terminals) kept in a spool until :meth:`finish`.  Writing
+    a table's lots one by one gives the text writing the whole table gives."""
+
+    def __init__(self, write: Callable[[str], object], *, seed: int, attrs: dict) -> None:
+        self.write = write
+        self.rows = 0
+        # the lots' text: in memory up to a few megabytes, then in a temporary file
+        self.lots = tempfile.SpooledTemporaryFile(  # noqa: SIM115 - closed by finish()
+            max_size=1 << 20, mode="w+", encoding="utf-8"
+        )
+        self.n_lots = 0
+        write(
+            f'{{\n  "bgr": 1,\n  "seed": {_dumps(seed)},\n  "attrs": {_dumps(attrs)},\n'
+            '  "terminals": ['
+        )
+
+    def add(self, table: TerminalTable) -> None:
+        with _no_gc():
+            rows = terminal_dicts(table)
+            if rows:
+                self.write(
+                    (",\n" if self.rows else "\n") + ",\n".join(["    " + _dumps(t) for t in rows])
+                )
+                self.rows += len(rows)
+            for lot in table.lots:
+                text = "    " + _dumps({k: lot[k] for k in LOT_KEYS if k in lot})
+                self.lots.write((",\n" if self.n_lots else "") + text)
+                self.n_lots += 1
+
+    def finish(self) -> None:
+        self.write("\n  ]" if self.rows else "]")
+        if self.n_lots:
+            self.write(',\n  "lots": [\n')
+            self.lots.seek(0)
+            while chunk := self.lots.read(1 << 20):
+                self.write(chunk)
+            self.write("\n  ]\n}\n")
+        else:
+            self.write("\n}\n")
+        self.lots.close()
 
 
 def write_json(table: TerminalTable, stream: TextIO, *, seed: int, attrs: dict) -> None:

@@ -11,10 +11,13 @@ Lots are sent out in batches and a bounded number of batches is in flight at onc
 yielded in lot order as soon as they are ready, so a caller that writes each lot and drops it
 (the streaming writers of :mod:`bgr.formats.sinks`) holds a few batches, not the city.
 
-The budgets (``max_shapes``, ``max_triangles``) hold for the whole run.  Derived in this
-process, each lot starts from the counts of the lots before it, so a runaway stops mid-lot;
-derived elsewhere, each lot gets the whole budget and this process adds the counts up as the
-results come in.  A run that succeeds writes the same files either way.
+The budgets (``max_shapes``, ``max_triangles``) hold for the whole run, or for each lot on its
+own with ``Job.per_lot`` (``bgr derive`` writing a streamed format: memory then holds one lot
+at a time, and a city of 100,000 lots must not be stopped by a budget meant for one run).  For
+the whole run, lots derived in this process start from the counts of the lots before them, so
+a runaway stops mid-lot; lots derived elsewhere get the whole budget each, and this process
+adds the counts up as the results come in.  A run that succeeds writes the same files either
+way.
 """
 
 from __future__ import annotations
@@ -57,6 +60,9 @@ class Job:
     max_shapes: int = 3_500_000
     max_triangles: int = 20_000_000
     max_memory: int | None = None  # None: 80 % of the memory available to the process deriving
+    # the shape and triangle budgets hold for each lot on its own (a run whose lots are written
+    # as they come and dropped), not for all lots together (a run that keeps them all)
+    per_lot: bool = False
     # names the run in a worker that outlives it (a Dask worker): its split cache is the run's
     token: str = field(default_factory=lambda: uuid.uuid4().hex)
 
@@ -202,8 +208,9 @@ def _serial(job: Job, numbered: Iterator[tuple[int, Lot]]) -> Iterator[LotResult
         result = derive_lot(job, index, lot, shapes=shapes, triangles=triangles, cache=cache)
         if result.error is not None:
             raise result.error
-        shapes += result.shapes
-        triangles += result.triangles
+        if not job.per_lot:
+            shapes += result.shapes
+            triangles += result.triangles
         yield result
 
 
@@ -211,6 +218,8 @@ def _checked(job: Job, result: LotResult, shapes: int, triangles: int) -> LotRes
     """A result from a worker, raised if it failed or if the run's budgets are now passed."""
     if result.error is not None:
         raise result.error
+    if job.per_lot:
+        return result
     for made, limit, what, option in (
         (shapes, job.max_shapes, "shapes", "--max-shapes"),
         (triangles, job.max_triangles, "triangles of terminals", "--max-triangles"),

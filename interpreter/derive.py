@@ -108,7 +108,7 @@ def derive(
     for result in derive_lots(job, lots):
         warnings.items.extend(result.warnings)
         parts.append(result.table)
-    table = concat(parts, site=_site(lots), grammar=str(job.grammar.path or ""))
+    table = concat(parts, site=site_of(lots), grammar=str(job.grammar.path or ""))
     return Result(table, seed, job.values, _once(warnings.items))
 
 
@@ -125,10 +125,12 @@ def prepare(
     start: str | None = None,
     strict: bool = False,
     allow_paths: Iterable[str | os.PathLike] = (),
+    per_lot: bool = False,
 ) -> tuple[Job, list[Lot], Warnings]:
     """The checks of :func:`derive`, and what deriving its lots one by one needs: the run's
     :class:`Job`, its lots, and the warnings reading the lots raised.  ``bgr derive`` uses it
-    to derive lots on workers and write them as they come (:mod:`bgr.interpreter.batch`)."""
+    to derive lots on workers and write them as they come (:mod:`bgr.interpreter.batch`);
+    ``per_lot``: the shape and triangle budgets hold for each lot on its own (see Job)."""
     if not isinstance(grammar, Grammar):
         grammar = load(grammar, allow_paths=allow_paths)
     _check_seed(seed)
@@ -136,7 +138,7 @@ def prepare(
     attrs = _checked_attrs(attrs)
     warnings = Warnings(strict)
     lots = _lots(lot, warnings)
-    _site(lots)
+    site_of(lots)
     values = Engine(grammar, seed, attrs, max_depth, max_shapes).attrs  # the run's attrs
     if max_memory is None:
         max_memory = default_max_memory()
@@ -152,6 +154,7 @@ def prepare(
         max_shapes=max_shapes,
         max_triangles=max_triangles,
         max_memory=max_memory,
+        per_lot=per_lot,
     )
     return job, lots, warnings
 
@@ -167,7 +170,7 @@ def _once(items: list[Diagnostic]) -> list[Diagnostic]:
     return out
 
 
-def _site(lots: list[Lot]) -> dict | None:
+def site_of(lots: list[Lot]) -> dict | None:
     """Where the run's local metres are on Earth (TerminalTable.site): the lots' common site
     (read_geojson gives every lot of a file the same one), None for plain metres.  Lots placed
     in different CRSs or about different origins cannot share one output file."""
