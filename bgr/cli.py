@@ -106,6 +106,7 @@ def build_parser() -> argparse.ArgumentParser:
         metavar="W,D|LOTS.geojson",
         help="the lot: width,depth in metres (default 20,20) or GeoJSON footprints",
     )
+    add_lot_options(derive)
     derive.add_argument(
         "--group-by",
         choices=["lot", "label", "none"],
@@ -198,6 +199,7 @@ def build_parser() -> argparse.ArgumentParser:
     render.add_argument(
         "--lot", metavar="W,D|LOTS.geojson", help="the lot of a .bgr, as for derive"
     )
+    add_lot_options(render)
     add_budget_options(render)
     render.add_argument(
         "--strict", action="store_true", help="treat a .bgr's warnings as errors, as for derive"
@@ -340,6 +342,55 @@ def build_parser() -> argparse.ArgumentParser:
     )
     mode.add_argument("-w", "--write", action="store_true", help="rewrite the files in place")
     return parser
+
+
+def add_lot_options(command: argparse.ArgumentParser) -> None:
+    """--map and --front: how the footprints of a GeoJSON --lot become lots (docs/cli.md, Lots)."""
+    command.add_argument(
+        "--map",
+        action="append",
+        default=[],
+        type=_argument("parse_map"),
+        metavar="NAME=PROPERTY[:TYPE]",
+        help="set attr NAME from each footprint's PROPERTY (it may hold colons), coerced to "
+        "TYPE int (rounded, halves away from zero), float, str or bool; repeatable, e.g. "
+        "--map floors=building:levels:int",
+    )
+    command.add_argument(
+        "--front",
+        type=_argument("parse_front"),
+        metavar="first|longest|street:LINES.geojson",
+        help="each footprint's front edge (the scope's x): its first edge (default), its longest, "
+        "or the one nearest to a line of a GeoJSON street file in the lots' CRS",
+    )
+
+
+def _argument(parser: str):
+    """An argparse type from a parser of interpreter/lots.py (imported when used: numpy and
+    shapely are slow to load for bgr check) that raises BgrError: a bad value is a usage error."""
+
+    def convert(text: str):
+        from .interpreter import lots
+
+        try:
+            return getattr(lots, parser)(text)
+        except BgrError as e:
+            raise argparse.ArgumentTypeError(e.message) from None
+
+    return convert
+
+
+def lot_options(args):
+    """The LotOptions of --front and --map, None without them, or what is wrong with them."""
+    from .interpreter.lots import LotOptions
+
+    if not args.map and args.front is None:
+        return None
+    lot = args.lot or ""
+    if not lot or ("," in lot and not lot.lower().endswith((".json", ".geojson"))):
+        return "--front and --map apply to a GeoJSON lot file: give --lot LOTS.geojson"
+    front, streets = args.front or ("first", None)
+    return LotOptions(front=front, streets=streets, mapping=tuple(args.map))
 
 
 def add_budget_options(command: argparse.ArgumentParser) -> None:
@@ -550,6 +601,7 @@ def cmd_derive(args) -> int:
     from .formats.sinks import open_sink, streams
     from .interpreter.batch import default_workers, derive_lots
     from .interpreter.derive import prepare, site_of
+    from .interpreter.lots import check_mapping
 
     if args.output in (None, "-") and args.format != "json":
         print(
@@ -565,12 +617,17 @@ def cmd_derive(args) -> int:
             print(f"bgr derive: --set {item}: write NAME=VALUE", file=sys.stderr)
             return EXIT_USAGE
         attrs[name.strip()] = _parse_value(value.strip(), item)
+    options = lot_options(args)
+    if isinstance(options, str):
+        print(f"bgr derive: {options}", file=sys.stderr)
+        return EXIT_USAGE
     limits = budgets(args)
     if isinstance(limits, str):
         print(f"bgr derive: {limits}", file=sys.stderr)
         return EXIT_USAGE
     workers = args.workers or default_workers()
     grammar = load(Path(args.file), path=args.file, allow_paths=args.allow_path)
+    check_mapping(options, grammar.attrs, args.file)
     output = "-" if args.output in (None, "-") else args.output
     fmt = args.format if output != "-" else "json"
     job, lots, warnings = prepare(
@@ -579,6 +636,7 @@ def cmd_derive(args) -> int:
         attrs=attrs,
         lot=args.lot,
         strict=args.strict,
+        lot_options=options,
         # a streamed file holds one lot at a time: the shape and triangle budgets are per lot
         per_lot=streams(output, fmt, args.group_by),
         **limits,
@@ -729,11 +787,20 @@ def cmd_render(args) -> int:
         return usage("--legend goes with --mode labels")
     is_grammar = Path(args.file).suffix.lower() == ".bgr"
     if not is_grammar and (
-        args.seed is not None or args.set or args.lot is not None or args.strict
+        args.seed is not None
+        or args.set
+        or args.lot is not None
+        or args.strict
+        or args.map
+        or args.front
     ):
         return usage(
-            "--seed, --set, --lot and --strict apply to a .bgr grammar, not to a model file"
+            "--seed, --set, --lot, --map, --front and --strict apply to a .bgr grammar, not to "
+            "a model file"
         )
+    options = lot_options(args)
+    if isinstance(options, str):
+        return usage(options)
     attrs = {}
     for item in args.set:
         name, sep, value = item.partition("=")
@@ -760,6 +827,7 @@ def cmd_render(args) -> int:
         strict=args.strict,
         **limits,
         allow_paths=args.allow_path,
+        lot_options=options,
     )
     for warning in scene.warnings:
         print(warning.render(), file=sys.stderr)

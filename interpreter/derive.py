@@ -20,7 +20,7 @@ from .limits import (
     DEFAULT_MAX_TRIANGLES,
     default_max_memory,
 )
-from .lots import DEFAULT_LOT, Lot, parse_lot_option, rectangle
+from .lots import DEFAULT_LOT, Lot, LotOptions, parse_lot_option, rectangle
 from .randomness import child_hash, name_hash, root_hash
 from .terminals import TerminalTable, concat
 from .values import SEED_RANGE, number_problem
@@ -68,6 +68,7 @@ def derive(
     start: str | None = None,
     strict: bool = False,
     allow_paths: Iterable[str | os.PathLike] = (),
+    lot_options: LotOptions | None = None,
 ) -> Result:
     """Derive a grammar on one lot or several.
 
@@ -86,6 +87,8 @@ def derive(
     starts).  Passing one of them raises a located :class:`bgr.BgrError`; see docs/limits.md.
 
     ``allow_paths`` is passed to :func:`bgr.load` when ``grammar`` is not loaded yet.
+    ``lot_options`` (:class:`~bgr.interpreter.lots.LotOptions`: the front edge, ``--map``) apply
+    when ``lot`` is a GeoJSON path.
 
     Every argument is checked before anything is derived (docs/cli.md, "Values from outside"):
     a seed outside -2**63 .. 2**64 - 1, limits under 1, attrs that are not finite numbers of at
@@ -103,6 +106,7 @@ def derive(
         start=start,
         strict=strict,
         allow_paths=allow_paths,
+        lot_options=lot_options,
     )
     parts = []
     for result in derive_lots(job, lots):
@@ -125,6 +129,7 @@ def prepare(
     start: str | None = None,
     strict: bool = False,
     allow_paths: Iterable[str | os.PathLike] = (),
+    lot_options: LotOptions | None = None,
     per_lot: bool = False,
 ) -> tuple[Job, list[Lot], Warnings]:
     """The checks of :func:`derive`, and what deriving its lots one by one needs: the run's
@@ -137,7 +142,7 @@ def prepare(
     _check_limits(max_depth=max_depth, max_shapes=max_shapes, max_triangles=max_triangles)
     attrs = _checked_attrs(attrs)
     warnings = Warnings(strict)
-    lots = _lots(lot, warnings)
+    lots = _lots(lot, warnings, lot_options)
     site_of(lots)
     values = Engine(grammar, seed, attrs, max_depth, max_shapes).attrs  # the run's attrs
     if max_memory is None:
@@ -231,12 +236,12 @@ def _checked_attrs(attrs: object) -> dict:
     return out
 
 
-def _lots(lot: object, warnings: Warnings) -> list[Lot]:
+def _lots(lot: object, warnings: Warnings, options: LotOptions | None = None) -> list[Lot]:
     """The lots ``derive(lot=)`` names: see its docstring; anything else is a BgrError."""
     if lot is None:
         return [rectangle(*DEFAULT_LOT)]
     if isinstance(lot, (str, os.PathLike)):
-        return parse_lot_option(os.fspath(lot), warnings)
+        return parse_lot_option(os.fspath(lot), warnings, options)
     if isinstance(lot, Lot):
         return [lot]
     if (

@@ -205,11 +205,12 @@ def load_scene(
     max_triangles: int | None = None,
     max_memory: int | None = None,
     allow_paths: Iterable[str | os.PathLike] = (),
+    lot_options: Any = None,
 ) -> Scene:
     """A :class:`Scene` from a Scene, a ``bgr.Result``, a terminal table, a trimesh, or a path to
     a ``.bgr`` (loaded with ``allow_paths`` as :func:`bgr.load`, derived with ``seed``,
     ``attrs``, ``lot`` and ``strict``, its warnings kept in ``Scene.warnings``), ``.glb`` or
-    ``.gltf`` file."""
+    ``.gltf`` file.  ``lot_options`` (a LotOptions: --front, --map) go to the derivation."""
     if isinstance(source, Scene):
         return source
     if isinstance(source, (str, os.PathLike)):
@@ -229,8 +230,19 @@ def load_scene(
                 )
                 if v is not None
             }
+            from ..interpreter.lots import check_mapping
+
             grammar = load(path, path=str(source), allow_paths=allow_paths)
-            result = derive(grammar, seed=seed, attrs=attrs, lot=lot, strict=strict, **limits)
+            check_mapping(lot_options, grammar.attrs, str(source))
+            result = derive(
+                grammar,
+                seed=seed,
+                attrs=attrs,
+                lot=lot,
+                strict=strict,
+                lot_options=lot_options,
+                **limits,
+            )
             return from_result(result)
         if suffix in (".glb", ".gltf"):
             return from_gltf(path)

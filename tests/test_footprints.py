@@ -60,9 +60,10 @@ def heights(result: bgr.Result) -> list[float]:
 
 
 def lot_area(lot) -> float:
+    """The area of a lot's shape, holes taken out."""
     polys = lot.shape.geom.polys
-    ring = [(0, 0), (1, 0), (1, 1), (0, 1)] if polys == "rect" else polys[0][0]
-    return Polygon(ring).area * lot.shape.size[0] * lot.shape.size[2]
+    ring, holes = ([(0, 0), (1, 0), (1, 1), (0, 1)], []) if polys == "rect" else polys[0]
+    return Polygon(ring, holes).area * lot.shape.size[0] * lot.shape.size[2]
 
 
 def world_ring(lot) -> np.ndarray:
@@ -117,10 +118,11 @@ def test_clean_ring_tolerance_is_a_millimetre():
     assert len(clean_ring(bent)[0]) == 5
 
 
-def test_holes_are_filled(tmp_path):
+def test_holes_are_kept(tmp_path):
     outer, hole = square(0, 0, 20), square(5, 5, 10)[::-1]
     (lot,) = read_geojson(write(tmp_path, feature([outer, hole])))
-    assert lot_area(lot) == pytest.approx(400.0)
+    ((_, holes),) = lot.shape.geom.polys
+    assert len(holes) == 1 and lot_area(lot) == pytest.approx(300.0)
     result = bgr.derive(BOX, lot=str(write(tmp_path, feature([outer, hole]), name="h.geojson")))
     assert not result.warnings
 
@@ -270,18 +272,25 @@ def test_a_legacy_geographic_crs_member_is_projected_even_over_a_degree(tmp_path
     assert plain.site is None and plain.shape.size[0] == pytest.approx(2.0)
 
 
-def test_an_unknown_crs_member_is_ignored_with_a_warning(tmp_path):
-    from bgr.grammar.errors import Warnings
-
+@pytest.mark.parametrize(
+    "crs, named",
+    [
+        ({"type": "name", "properties": {"name": "EPSG:999999"}}, "names no CRS bgr knows ('EPSG:"),
+        ({"type": "name", "properties": {"name": "urn:ogc:def:crs:EPSG::999999"}}, "('urn:ogc"),
+        ({"type": "EPSG", "properties": {"code": 4978}}, "neither longitude/latitude nor proj"),
+        ({"type": "name", "properties": {"name": 12}}, 'no CRS bgr knows ({"type": "name"'),
+    ],
+)
+def test_an_unknown_crs_member_is_an_error(tmp_path, crs, named):
+    # read as metres (as it was until issue 13, with a warning) the buildings would be misplaced
     ring = [[0, 0], [10, 0], [10, 8], [0, 8], [0, 0]]
-    path = with_crs(tmp_path, {"type": "name", "properties": {"name": "EPSG:999999"}}, ring)
-    warnings = Warnings()
-    (lot,) = read_geojson(path, warnings)
-    assert lot.site is None and lot.shape.size == pytest.approx((10.0, 0.0, 8.0))
-    (warning,) = messages(warnings.items)
-    assert "names no known geographic or projected CRS" in warning
-    with pytest.raises(bgr.BgrError, match="no known"):
-        bgr.derive(BOX, lot=str(path), strict=True)
+    path = with_crs(tmp_path, crs, ring)
+    with pytest.raises(bgr.BgrError) as caught:
+        bgr.derive(BOX, lot=str(path))
+    error = caught.value
+    assert error.path == str(path) and error.message.startswith("the lot file's crs member")
+    assert named in error.message
+    assert "ogr2ogr -t_srs EPSG:4326" in error.hint and "projected CRS in metres" in error.hint
 
 
 def test_a_ring_that_does_not_project_is_skipped(tmp_path):
@@ -583,7 +592,7 @@ def test_a_hostile_feature_is_skipped_or_refused_by_name(tmp_path, bad, why):
     warning = result.warnings[0]  # a MultiPolygon warns once for each of its polygons
     assert warning.message.startswith("feature 1 (no id)") and why in warning.message
     alone = write(tmp_path, bad, name="alone.geojson")  # the only feature: the error says why
-    none = "has no (usable footprint|Polygon features): feature 0 .* skipped: "
+    none = "has no (usable footprint|Polygon features): feature 0 .* skipped: |only feature has no"
     with pytest.raises(bgr.BgrError, match=none):
         bgr.derive(BOX, lot=str(alone))
 
@@ -629,7 +638,7 @@ def test_a_property_out_of_range_keeps_the_attr(tmp_path, text, why):
         ('{"type": "FeatureCollection", "features": {}}', "FeatureCollection or Feature"),
         ("null", "FeatureCollection or Feature"),
         ("[1, 2]", "FeatureCollection or Feature"),
-        ('{"type": "FeatureCollection", "features": [[1], "x", null, 3]}', "no Polygon features"),
+        ('{"type": "FeatureCollection", "features": [[1], "x", null, 3]}', "none of the lot fi"),
         ('{"type": "Feature"', "not valid JSON"),
     ],
 )

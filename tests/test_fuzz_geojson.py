@@ -85,9 +85,38 @@ LEGACY_CRS = [
 ]
 
 
+# a courtyard block (its inner ring a hole of the lot since issue 13) and a house beside it
+COURTYARD = {
+    "type": "FeatureCollection",
+    "features": [
+        {
+            "type": "Feature",
+            "properties": {"building:levels": "5", "height": 16},
+            "geometry": {
+                "type": "Polygon",
+                "coordinates": [
+                    [[0, 0], [40, 0], [40, 30], [0, 30], [0, 0]],
+                    [[10, 8], [10, 22], [30, 22], [30, 8], [10, 8]],
+                    [[33, 3], [33, 6], [36, 6], [36, 3], [33, 3]],
+                ],
+            },
+        },
+        {
+            "type": "Feature",
+            "properties": {"height": 7},
+            "geometry": {
+                "type": "Polygon",
+                "coordinates": [[[50, 0], [60, 0], [60, 8], [50, 8], [50, 0]]],
+            },
+        },
+    ],
+}
+
+
 def seeds() -> list:
     files = sorted(ROOT.glob("examples/*.geojson")) + sorted(ROOT.glob("tests/data/**/*.geojson"))
-    return [json.loads(p.read_text(encoding="utf-8")) for p in files] + [LONLAT, *LEGACY_CRS]
+    docs = [json.loads(p.read_text(encoding="utf-8")) for p in files]
+    return docs + [LONLAT, *LEGACY_CRS, COURTYARD]
 
 
 SEEDS = seeds()

@@ -295,6 +295,24 @@ def test_flat_is_the_footprint():
     assert area == pytest.approx(Polygon(poly).buffer(0.5, join_style="mitre").area)
 
 
+def test_flat_leaves_holes_open():
+    """A courtyard stays open under a flat roof, shrunk by the overhang (the eaves reach into
+    it); the skeleton kinds are built on the outline alone (see roofs.py, "Holes")."""
+    outer = np.array([[0, 0], [30, 0], [30, 20], [0, 20]], dtype=float)
+    hole = np.array([[10, 5], [10, 15], [20, 15], [20, 5]], dtype=float)  # clockwise
+    for overhang in (0.0, 0.5):
+        mesh = roof_mesh(outer, "flat", 0, overhang=overhang, holes=[hole])
+        tris = [Polygon(mesh.vertices[f, :2]) for f in mesh.faces]
+        assert all(t.exterior.is_ccw for t in tris)  # facing up
+        expected = Polygon(outer).buffer(overhang, join_style="mitre").area - (
+            10 - 2 * overhang
+        ) * (10 - 2 * overhang)
+        assert sum(t.area for t in tris) == pytest.approx(expected)
+        assert not any(t.contains(shapely.Point(15, 10)) for t in tris)
+    hip = roof_mesh(outer, "hip", PITCH, holes=[hole])
+    assert hip.vertices[:, 2].max() == pytest.approx(10 * TAN)  # over the whole block
+
+
 @pytest.mark.parametrize("kind", KINDS)
 @pytest.mark.parametrize("name", list(SHAPES))
 @pytest.mark.parametrize("overhang", [0.0, 0.4])

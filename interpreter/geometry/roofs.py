@@ -34,7 +34,8 @@ Kinds
     footprint (``z = tan(pitch) * distance to that edge's line``, raised if some corner lies
     behind that line so that nothing is below the eave), plus vertical walls down to the eave.
 ``flat``
-    The footprint itself at z = 0, triangulated (pitch is ignored).
+    The footprint itself at z = 0, triangulated (pitch is ignored), with its holes (courtyards)
+    left open: each hole shrinks by the overhang, as the eaves reach into the courtyard.
 ``mansard``
     Two hip slopes: a steep lower band at ``mansard_lower_pitch(pitch) = 45 + pitch / 2`` degrees
     over the first third (``MANSARD_BREAK``) of the largest inset distance, then a shallow hip at
@@ -74,6 +75,13 @@ nearest the apex get less than ``overhang`` and the eave slopes.  (Carrying ever
 ``overhang`` over the apex's clearance, as before, gave a 6 m x 70 m footprint 5.8 m eaves at its
 ends for a 0.5 m overhang, and a needle eaves of two kilometres.)
 
+Holes
+-----
+A footprint's holes (``holes=``: the courtyards of a block) are kept by a ``flat`` roof only.  The
+straight skeleton here is that of a simple polygon, so the other kinds are built on the outline
+alone and roof a courtyard over (as a hip roof over the whole block would); a grammar that meets
+courtyard blocks can give them flat roofs.
+
 Output
 ------
 A :class:`RoofMesh`: vertices (V, 3), triangles (F, 3) counter-clockwise seen from outside,
@@ -88,6 +96,7 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
+import shapely
 from shapely.geometry import Point, Polygon
 from shapely.ops import polylabel
 
@@ -140,8 +149,9 @@ class RoofMesh:
     fallback: str = ""  # why the kind built is not the kind asked for, when that is a surprise
 
 
-def roof_mesh(polygon, kind: str, pitch: float, overhang: float = 0.0) -> RoofMesh:
-    """The roof of ``kind`` over ``polygon`` (K, 2); see the module docstring for each kind."""
+def roof_mesh(polygon, kind: str, pitch: float, overhang: float = 0.0, holes=()) -> RoofMesh:
+    """The roof of ``kind`` over ``polygon`` (K, 2); see the module docstring for each kind.
+    ``holes`` (rings (H, 2) inside the polygon) are left open by a flat roof (see "Holes")."""
     if kind not in KINDS:
         raise ValueError(f"unknown roof kind {kind!r}; expected one of {', '.join(KINDS)}")
     overhang = float(overhang)
@@ -152,7 +162,7 @@ def roof_mesh(polygon, kind: str, pitch: float, overhang: float = 0.0) -> RoofMe
         raise ValueError(f"roof pitch must be between 0 and 90 degrees, got {pitch}")
     fp = _Footprint.of(polygon)
     if kind == "flat":
-        return _flat_roof(fp, overhang)
+        return _flat_roof(fp, overhang, holes)
     if kind == "shed":
         return _shed_roof(fp, pitch, overhang)
     if kind == "pyramid":
@@ -667,11 +677,30 @@ def _shed_roof(fp: _Footprint, pitch: float, overhang: float) -> RoofMesh:
     return builder.finish(vertices[below], overhang, "shed")
 
 
-def _flat_roof(fp: _Footprint, overhang: float) -> RoofMesh:
-    """The eave polygon at z = 0."""
+def _flat_roof(fp: _Footprint, overhang: float, holes=()) -> RoofMesh:
+    """The eave polygon at z = 0, without the holes (each shrunk by the overhang)."""
     ring, _ = _eave_ring(fp, overhang, np.ones(len(fp.points)))
     vertices = np.column_stack([ring, np.zeros(len(ring))])
     builder = _MeshBuilder(vertices)
     plane = builder.plane("flat", RoofPlane, "flat", None, (), np.array([0.0, 0.0, 1.0]), 0.0, 0.0)
-    builder.add_polygon(np.arange(len(ring)), ring, plane)
+    open_holes = [
+        h.buffer(-overhang, join_style="mitre", mitre_limit=MITRE_LIMIT) if overhang > 0 else h
+        for h in (Polygon(np.asarray(hole, dtype=np.float64)) for hole in holes)
+        if h.is_valid and h.area > 0
+    ]
+    if not open_holes:
+        builder.add_polygon(np.arange(len(ring)), ring, plane)
+        return builder.finish(vertices, overhang, "flat")
+    from .polygons import from_shapely
+    from .polygons import triangulate as earcut
+
+    shape = Polygon(ring).difference(shapely.union_all(open_holes))
+    points, tris = earcut(from_shapely(shape))
+    if len(tris):  # counter-clockwise seen from above
+        a, b, c = points[tris[:, 0]], points[tris[:, 1]], points[tris[:, 2]]
+        flip = _cross(b - a, c - a) < 0
+        tris[flip] = tris[flip][:, ::-1]
+    builder = _MeshBuilder(np.column_stack([points, np.zeros(len(points))]))
+    plane = builder.plane("flat", RoofPlane, "flat", None, (), np.array([0.0, 0.0, 1.0]), 0.0, 0.0)
+    builder.add(tris, plane)
     return builder.finish(vertices, overhang, "flat")

@@ -60,8 +60,12 @@ def roof(app, shape, step, args) -> bool:
         verts.append(v)
         faces.append(f)
         polys = []
-    for ext, _holes in metric(polys, shape.size[p], shape.size[q]):
-        m = _mesh(app, step, np.asarray(ext, dtype=float), kind, float(pitch), float(overhang))
+    for ext, holes in metric(polys, shape.size[p], shape.size[q]):
+        # a flat roof leaves holes (courtyards) open; the skeleton kinds roof them over
+        holes = [np.asarray(h, dtype=float) for h in holes]
+        m = _mesh(
+            app, step, np.asarray(ext, dtype=float), kind, float(pitch), float(overhang), holes
+        )
         walls = np.array([m.planes[i].kind in ("gable", "wall") for i in m.face_plane], dtype=bool)
         m_vertices, m_faces = (
             clip_below(m.vertices, m.faces, walls)
@@ -94,7 +98,7 @@ def roof(app, shape, step, args) -> bool:
     return False
 
 
-def _mesh(app, step, polygon: np.ndarray, kind: str, pitch: float, overhang: float):
+def _mesh(app, step, polygon: np.ndarray, kind: str, pitch: float, overhang: float, holes=()):
     """The roof mesh, or a located error for a footprint the builder cannot use (not simple,
     degenerate).  Where the kind asked for could not be built and another was (a gable whose
     ends failed), or the straight skeleton gave up on a footprint (it should not; a flat roof
@@ -103,7 +107,7 @@ def _mesh(app, step, polygon: np.ndarray, kind: str, pitch: float, overhang: flo
     from ..geometry.roofs import roof_mesh
 
     try:
-        mesh = roof_mesh(polygon, kind, pitch, overhang)
+        mesh = roof_mesh(polygon, kind, pitch, overhang, holes)
     except ValueError as e:
         raise runtime_error(
             app.module, step.pos, f"cannot build a {kind} roof on this footprint: {e}"
@@ -112,7 +116,7 @@ def _mesh(app, step, polygon: np.ndarray, kind: str, pitch: float, overhang: flo
         app.engine.warn(
             app.module, step.pos, f"cannot build a {kind} roof on this footprint ({e}); built flat"
         )
-        return roof_mesh(polygon, "flat", pitch, overhang)
+        return roof_mesh(polygon, "flat", pitch, overhang, holes)
     if mesh.fallback:
         app.engine.warn(
             app.module,
