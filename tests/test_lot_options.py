@@ -14,7 +14,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from conftest import SHARED
+from conftest import ROOT
 
 import bgr
 from bgr.grammar.errors import Warnings
@@ -27,7 +27,8 @@ from bgr.interpreter.lots import (
     read_geojson,
 )
 
-HELSINKI = SHARED / "data" / "footprints" / "helsinki_osm_buildings.geojson"
+# OpenStreetMap data (ODbL), committed with its attribution: examples/helsinki/README.md
+HELSINKI = ROOT / "examples" / "helsinki" / "helsinki_osm_buildings.geojson"
 FLOORS = 'attr floors = 2\nattr kind = "house"\nattr big = false\nterminal X\n'
 FLOORS += "Lot --> extrude(floors * 3) X\n"
 
@@ -566,10 +567,9 @@ def test_a_self_crossing_outline_is_repaired_with_a_warning(tmp_path):
 
 
 # ---------------------------------------------------------------------------------------------
-# Helsinki (../shared/data; skipped without it)
+# Helsinki: examples/helsinki
 
 
-@pytest.mark.skipif(not HELSINKI.exists(), reason=f"no Helsinki footprints at {HELSINKI}")
 def test_helsinki_levels_and_courtyards():
     warnings = Warnings()
     lots = read_geojson(HELSINKI, warnings, options("floors=building:levels:int"))
@@ -587,3 +587,25 @@ def test_helsinki_levels_and_courtyards():
     # every front faces into its lot (25 of these did not before issue 13), and every longest
     lots += read_geojson(HELSINKI, Warnings(), options(front="longest"))
     assert all(inside_is_plus_z(lot) for lot in lots)
+
+
+EXAMPLE = HELSINKI.parent
+
+
+def test_the_helsinki_example_derives_with_its_levels(tmp_path):
+    """examples/helsinki on 60 of its footprints (the whole file takes about 40 s): every one is
+    derived, its storeys from building:levels where it has the tag, 4 elsewhere."""
+    data = json.loads((EXAMPLE / "helsinki_osm_buildings.geojson").read_text())
+    data["features"] = [f for f in data["features"] if f["geometry"]["type"] == "Polygon"][:60]
+    geo = tmp_path / "part.geojson"
+    geo.write_text(json.dumps(data))
+    result = bgr.derive(
+        EXAMPLE / "helsinki.bgr", lot=str(geo), lot_options=options("floors=building:levels:int")
+    )
+    lots = result.terminals.lots
+    skipped = [w for w in result.warnings if "skipped" in w.message]
+    assert len(lots) == 60 - len(skipped) and len(result.terminals) > 10_000
+    for lot in lots:
+        tag = lot["properties"].get("building:levels")
+        assert lot["attrs"]["floors"] == (4 if tag is None else int(float(tag) + 0.5))
+    assert len({lot["attrs"]["floors"] for lot in lots}) >= 5  # tagged 2, 3, 5, 7, 9 here
