@@ -231,12 +231,12 @@ def test_infer_and_write_text_refuse_a_fifo_output(tmp_path, root):
 
 SLOW_WRITE = """
 import sys, time
-import bgr.formats as w
-def slow(table, stream, **kwargs):
+import bgr.formats.glb as glb
+def slow(self, stream):
     stream.write(b"partial")
     stream.flush()
     time.sleep(30)
-w.FORMATS["glb"] = slow
+glb.Scene.write_glb = slow  # bgr derive streams a GLB through Scene (formats/sinks.py)
 from bgr.cli import main
 sys.exit(main(sys.argv[1:]))
 """
