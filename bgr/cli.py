@@ -407,14 +407,16 @@ def add_budget_options(command: argparse.ArgumentParser) -> None:
         type=_whole,
         default=DEFAULT_MAX_SHAPES,
         metavar="N",
-        help=f"shape budget of the run (default {DEFAULT_MAX_SHAPES:,})",
+        help=f"shape budget of the run, or of each lot when derive streams its output "
+        f"(.glb .city.jsonl .json) (default {DEFAULT_MAX_SHAPES:,})",
     )
     command.add_argument(
         "--max-triangles",
         type=_whole,
         default=DEFAULT_MAX_TRIANGLES,
         metavar="N",
-        help=f"triangle budget of the terminals (default {DEFAULT_MAX_TRIANGLES:,})",
+        help=f"triangle budget of the terminals, of the run or of each lot as --max-shapes "
+        f"(default {DEFAULT_MAX_TRIANGLES:,})",
     )
     command.add_argument(
         "--max-memory",
