@@ -214,7 +214,7 @@ def build_parser() -> argparse.ArgumentParser:
 
     infer = commands.add_parser(
         "infer",
-        help="write a grammar from data: face schemas, or a whole city",
+        help="write a grammar from data: face schemas, a box hierarchy, or a whole city",
         description="Infer a .bgr grammar from data. --kind city (the default for .obj, .ply, "
         ".glb, .gltf and CityJSON inputs): city-scale proceduralization of a 3D city, a "
         "grammar of component types whose meshes go in an assets folder beside it "
@@ -222,7 +222,9 @@ def build_parser() -> argparse.ArgumentParser:
         "Build-by-Number face, floor and model schemas of a labelled, subdivided "
         "building: a terminal list (bgr derive -o x.json), a captured-model JSON "
         "(docs/inverse-schema.md) or a .bgr (derived first); the grammar, derived "
-        "with --lot, styles a new mass.",
+        'with --lot, styles a new mass. --kind boxes (the default for a .json with a "root" '
+        "box): a box hierarchy as nested splits whose derivation at other sizes (--set width, "
+        "height, length) follows bgr retarget (docs/inverse-boxes.md).",
     )
     infer.add_argument(
         "input",
@@ -234,8 +236,8 @@ def build_parser() -> argparse.ArgumentParser:
         "--kind",
         choices=["schema", "city", "boxes", "style", "image"],
         default=None,
-        help="what to infer (default: city for 3D models and CityJSON, schema otherwise; "
-        "boxes, style and image are not written yet)",
+        help="what to infer (default: city for 3D models and CityJSON, boxes for a box "
+        "hierarchy .json, schema otherwise; style and image are not written yet)",
     )
     infer.add_argument(
         "-o", "--output", metavar="OUT.bgr", help="write here (default: standard output)"
@@ -325,6 +327,30 @@ def build_parser() -> argparse.ArgumentParser:
     )
     city.add_argument(
         "--no-progress", action="store_true", help="no progress bars on standard error"
+    )
+
+    retarget = commands.add_parser(
+        "retarget",
+        help="resize a box hierarchy, replicating, scaling and fixing its boxes",
+        description="Structure-preserving retargeting of a box hierarchy (docs/inverse-boxes.md): "
+        "resize it to --size one axis at a time, R boxes replicated or deleted, S boxes "
+        "scaled, F boxes kept, alignments kept where they can be. Writes the retargeted boxes "
+        "(.json, itself a valid input) or a model with each box's mesh fitted (.glb .gltf .obj "
+        ".ply .stl; a cube for a leaf without one).",
+    )
+    retarget.add_argument("input", metavar="BOXES.json", help="the box hierarchy")
+    retarget.add_argument(
+        "--size", required=True, metavar="W,H,D", help="the new size in metres: x, y (up), z"
+    )
+    retarget.add_argument(
+        "--order",
+        default="xyz",
+        metavar="AXES",
+        help="the axes in the order they are retargeted (default xyz); the order changes the "
+        "result, e.g. yx against xy",
+    )
+    retarget.add_argument(
+        "-o", "--output", metavar="OUT", help="OUT.json or a model file (default: JSON on stdout)"
     )
 
     fmt = commands.add_parser(
@@ -702,9 +728,13 @@ def cmd_infer(args) -> int:
         from .inverse.city.command import run
 
         return run(args)
+    if kind == "boxes":
+        from .inverse.boxes.command import run_infer
+
+        return run_infer(args)
     if kind != "schema":
         print(
-            f"bgr infer: --kind {kind} is not written yet; --kind schema and city are",
+            f"bgr infer: --kind {kind} is not written yet; --kind schema, city and boxes are",
             file=sys.stderr,
         )
         return EXIT_INPUT
@@ -742,6 +772,8 @@ def _infer_kind(path: str) -> str:
                 head = f.read(4096)
             if re.search(rb'"type"\s*:\s*"CityJSON"', head):
                 return "city"
+            if re.match(rb'\s*\{\s*"root"\s*:', head):
+                return "boxes"
     return "schema"
 
 
@@ -853,7 +885,14 @@ def cmd_render(args) -> int:
     return EXIT_OK
 
 
+def cmd_retarget(args) -> int:
+    from .inverse.boxes.command import run_retarget
+
+    return run_retarget(args)
+
+
 COMMANDS = {
+    "retarget": cmd_retarget,
     "check": cmd_check,
     "fmt": cmd_fmt,
     "derive": cmd_derive,

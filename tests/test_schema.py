@@ -267,7 +267,7 @@ def test_cli_bad_inputs_exit_1_with_the_element_named(tmp_path, capsys, content,
 
 
 def test_cli_other_kinds_say_they_are_not_written(capsys):
-    assert main(["infer", str(DATA / "palazzo.bgr"), "--kind", "boxes"]) == 1
+    assert main(["infer", str(DATA / "palazzo.bgr"), "--kind", "style"]) == 1
     assert "not written yet" in capsys.readouterr().err
 
 

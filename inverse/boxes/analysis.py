@@ -1,0 +1,284 @@
+"""The offline analysis of a box hierarchy along one axis (Lin et al. 2011, section 5).
+
+* **Alignment groups**: the faces across the axis of the finest boxes, clustered by position
+  within epsilon; a cluster of two or more faces whose total area exceeds the average cluster's
+  is a group.  Boxes higher up inherit the index where their faces coincide with the group's.
+* **Compatibility graph** of each node's children: an edge from box a to box b when a face of a
+  touches b across the axis (b above a, their cross-sections overlapping), or when a and b share
+  a whole face beside each other and have the same behaviour along the axis.
+* **Sequences**: the primary is the longest path (in boxes) from the child at the node's
+  bottom-front-left corner to the top, never moving down, left or back; the secondaries are
+  longest paths of what remains, from the lowest to the highest boxes of its components, each
+  attached to the boxes of earlier sequences it touches (its anchors).
+* **Sequence hierarchy**: the order the retargeting visits them, depth first.
+
+"Up" is the axis being retargeted; the two other axes are the sideways directions.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .model import EPS, Box
+
+
+@dataclass
+class Unit:
+    """Boxes of a sequence side by side over the same interval: resized as one box."""
+
+    boxes: list[int]  # indices into the node's children
+    lo: float
+    hi: float
+    tag: str
+
+    @property
+    def length(self) -> float:
+        return self.hi - self.lo
+
+
+@dataclass
+class Sequence:
+    units: list[Unit]
+    below: list[int]  # children the first unit rests on (empty: the node's bottom)
+    above: list[int]  # children resting on the last unit (empty: the node's top)
+    primary: bool = False
+
+    @property
+    def boxes(self) -> list[int]:
+        return [b for u in self.units for b in u.boxes]
+
+
+@dataclass
+class NodeAnalysis:
+    """A node's children along one axis: their graph's edges and their sequences in order."""
+
+    edges: list[tuple[int, int]]
+    sequences: list[Sequence]
+    touch: np.ndarray  # touch[i, j]: child j rests on child i across the axis
+
+
+@dataclass
+class Analysis:
+    axis: int
+    groups: dict[int, list[float]]  # alignment index -> [position, total area]
+    nodes: dict[int, NodeAnalysis] = field(default_factory=dict)  # by id() of the box
+
+    def of(self, box: Box) -> NodeAnalysis:
+        return self.nodes[id(box)]
+
+    def group_at(self, position: float) -> int | None:
+        """The alignment index of a face at ``position``, or None."""
+        for index, (where, _) in self.groups.items():
+            if abs(where - position) <= EPS:
+                return index
+        return None
+
+    @property
+    def sequence_count(self) -> int:
+        return sum(len(n.sequences) for n in self.nodes.values())
+
+
+def analyse(root: Box, axis: int) -> Analysis:
+    """Alignment groups, compatibility graphs and sequences of every node along ``axis``."""
+    result = Analysis(axis, alignment_groups(root, axis))
+    for box in root.walk():
+        if box.children:
+            result.nodes[id(box)] = analyse_node(box, axis)
+    return result
+
+
+def alignment_groups(root: Box, axis: int) -> dict[int, list[float]]:
+    """Clusters of leaf faces across ``axis`` whose total area is above the average cluster's."""
+    others = [a for a in range(3) if a != axis]
+    faces = []  # (position, area)
+    for leaf in root.leaves():
+        area = float(leaf.size[others[0]] * leaf.size[others[1]])
+        faces.append((float(leaf.lo[axis]), area))
+        faces.append((float(leaf.hi[axis]), area))
+    faces.sort()
+    clusters: list[list[tuple[float, float]]] = []
+    for face in faces:
+        if clusters and face[0] - clusters[-1][-1][0] <= EPS:
+            clusters[-1].append(face)
+        else:
+            clusters.append([face])
+    candidates = [c for c in clusters if len(c) >= 2]
+    if not candidates:
+        return {}
+    totals = [sum(a for _, a in c) for c in candidates]
+    average = sum(totals) / len(totals)
+    groups: dict[int, list[float]] = {}
+    for c, total in zip(candidates, totals, strict=True):
+        if total > average - 1e-9 * average:  # "exceeds the average"; all equal: all kept
+            groups[len(groups)] = [sum(p for p, _ in c) / len(c), total]
+    return groups
+
+
+def _contacts(lo: np.ndarray, hi: np.ndarray, axis: int) -> np.ndarray:
+    """touch[i, j]: box j rests on box i across ``axis`` with overlapping cross-sections."""
+    others = [a for a in range(3) if a != axis]
+    touch = np.abs(hi[:, None, axis] - lo[None, :, axis]) <= EPS
+    for a in others:
+        touch &= (
+            np.minimum(hi[:, None, a], hi[None, :, a]) - np.maximum(lo[:, None, a], lo[None, :, a])
+        ) > EPS
+    return touch
+
+
+def analyse_node(box: Box, axis: int) -> NodeAnalysis:
+    kids = box.children
+    n = len(kids)
+    lo = np.array([c.lo for c in kids])
+    hi = np.array([c.hi for c in kids])
+    tags = [c.tags[axis] for c in kids]
+    others = [a for a in range(3) if a != axis]
+    up = _contacts(lo, hi, axis)
+    side = np.zeros((n, n), dtype=bool)
+    for k, c in enumerate(others):
+        d = others[1 - k]
+        coincide = (
+            (np.abs(hi[:, None, c] - lo[None, :, c]) <= EPS)
+            & (np.abs(lo[:, None, axis] - lo[None, :, axis]) <= EPS)
+            & (np.abs(hi[:, None, axis] - hi[None, :, axis]) <= EPS)
+            & (np.abs(lo[:, None, d] - lo[None, :, d]) <= EPS)
+            & (np.abs(hi[:, None, d] - hi[None, :, d]) <= EPS)
+        )
+        side |= coincide
+    same_tag = np.array(tags)[:, None] == np.array(tags)[None, :]
+    side &= same_tag
+    edge = up | side
+    # a topological order: every edge goes up, or sideways towards larger coordinates
+    order = sorted(
+        range(n),
+        key=lambda i: (
+            round(lo[i, axis], 9),
+            round(lo[i, others[0]], 9),
+            round(lo[i, others[1]], 9),
+            i,
+        ),
+    )
+    rank = np.empty(n, dtype=int)
+    rank[order] = np.arange(n)
+    edges = [(int(i), int(j)) for i, j in zip(*np.nonzero(edge), strict=True)]
+    succ: list[list[int]] = [[] for _ in range(n)]
+    for i, j in edges:
+        succ[i].append(j)
+    for s in succ:
+        s.sort(key=lambda j: rank[j])
+
+    sequences: list[Sequence] = []
+    used = np.zeros(n, dtype=bool)
+    bottom, top = box.lo[axis], box.hi[axis]
+    corner = [i for i in range(n) if np.all(np.abs(lo[i] - box.lo) <= EPS)]
+    while not used.all():
+        free = ~used
+        if not sequences:
+            starts = corner or [int(min(np.nonzero(free)[0], key=lambda i: rank[i]))]
+            # the primary ends at a box touching the top (the whole height, in a tessellation)
+            ends = [i for i in range(n) if hi[i, axis] >= top - EPS] or list(range(n))
+        else:
+            starts, ends = _lowest_and_highest(free, edge, lo[:, axis], hi[:, axis])
+        path = _longest_path(order, succ, free, starts, set(ends))
+        used[path] = True
+        units = _units(path, lo[:, axis], hi[:, axis], tags)
+        first, last = path[0], path[-1]
+        below = [int(j) for j in np.nonzero(up[:, first] & used)[0] if j not in path]
+        above = [int(j) for j in np.nonzero(up[last, :] & used)[0] if j not in path]
+        if lo[first, axis] <= bottom + EPS:
+            below = []
+        if hi[last, axis] >= top - EPS:
+            above = []
+        sequences.append(Sequence(units, below, above, primary=not sequences))
+    return NodeAnalysis(edges, sequences, up)
+
+
+def _lowest_and_highest(free, edge, lo, hi) -> tuple[list[int], list[int]]:
+    """The lowest and highest boxes of every component of the graph left (undirected)."""
+    n = len(free)
+    comp = -np.ones(n, dtype=int)
+    starts: list[int] = []
+    ends: list[int] = []
+    sym = edge | edge.T
+    for seed in np.nonzero(free)[0]:
+        if comp[seed] >= 0:
+            continue
+        members, stack = [], [int(seed)]
+        comp[seed] = seed
+        while stack:
+            i = stack.pop()
+            members.append(i)
+            for j in np.nonzero(sym[i] & free)[0]:
+                if comp[j] < 0:
+                    comp[j] = seed
+                    stack.append(int(j))
+        low = min(lo[members])
+        high = max(hi[members])
+        starts += [i for i in members if lo[i] <= low + EPS]
+        ends += [i for i in members if hi[i] >= high - EPS]
+    return sorted(starts), sorted(ends)
+
+
+def _longest_path(order, succ, free, starts, ends: set[int]) -> list[int]:
+    """The longest path (in boxes) through free boxes from a start to an end, by dynamic
+    programming over the topological order; ties go to the earlier box in that order."""
+    n = len(order)
+    length = np.zeros(n, dtype=int)  # 0: not reached
+    before = -np.ones(n, dtype=int)
+    for s in starts:
+        if free[s]:
+            length[s] = 1
+    best, best_len = -1, 0
+    for i in order:
+        if not free[i] or length[i] == 0:
+            continue
+        if i in ends and length[i] > best_len:
+            best, best_len = i, length[i]
+        for j in succ[i]:
+            if free[j] and length[i] + 1 > length[j]:
+                length[j] = length[i] + 1
+                before[j] = i
+    if best < 0:  # no end reachable (boxes hanging free): the first free box alone
+        best = next(i for i in order if free[i])
+    path = [best]
+    while before[path[-1]] >= 0:
+        path.append(int(before[path[-1]]))
+    return path[::-1]
+
+
+def _units(path: list[int], lo, hi, tags) -> list[Unit]:
+    """Consecutive boxes of a path over the same interval (sideways moves) are one unit."""
+    units: list[Unit] = []
+    for i in path:
+        if units and abs(units[-1].lo - lo[i]) <= EPS and abs(units[-1].hi - hi[i]) <= EPS:
+            units[-1].boxes.append(i)
+        else:
+            units.append(Unit([i], float(lo[i]), float(hi[i]), tags[i]))
+    return units
+
+
+def min_length(box: Box, axis: int, memo: dict | None = None) -> float:
+    """The shortest a box can become along ``axis``: its length when fixed, else the tallest
+    stack of its children's minimums (R children can be deleted, S leaves shrink to nothing)."""
+    memo = {} if memo is None else memo
+    key = id(box)
+    if key in memo:
+        return memo[key]
+    if box.tags[axis] == "F":
+        out = float(box.size[axis])
+    elif not box.children:
+        out = 0.0
+    else:
+        kids = box.children
+        lo = np.array([c.lo for c in kids])
+        hi = np.array([c.hi for c in kids])
+        up = _contacts(lo, hi, axis)
+        need = [0.0 if c.tags[axis] == "R" else min_length(c, axis, memo) for c in kids]
+        reach: dict[int, float] = {}
+        for i in sorted(range(len(kids)), key=lambda i: lo[i, axis]):
+            below = [reach[int(j)] for j in np.nonzero(up[:, i])[0] if int(j) in reach]
+            reach[i] = max(below, default=0.0) + need[i]
+        out = max(reach.values(), default=0.0)
+    memo[key] = out
+    return out

@@ -1,0 +1,243 @@
+"""``bgr retarget`` and ``bgr infer --kind boxes``: the command-line side."""
+
+from __future__ import annotations
+
+import re
+import sys
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from bgr.formats.atomic import write_text as write_atomic
+from bgr.grammar.errors import BgrError
+from bgr.grammar.formatter import format_module
+
+from .emit import ATTRS, write
+from .model import AXES, Box, dumps, read
+from .retarget import alignments, check_order, retarget
+
+USAGE = 2
+# the sizes infer checks its grammar at, as fractions of the input's (contraction and stretch)
+CHECK_SCALES = (0.6, 1.5, 2.5)
+
+
+def parse_size(text: str) -> tuple[float, float, float]:
+    parts = [p.strip() for p in text.split(",")]
+    try:
+        values = [float(p) for p in parts]
+    except ValueError:
+        values = []
+    if len(values) != 3 or not all(0 < v < 1e6 for v in values):
+        raise ValueError(f"--size {text}: write three lengths in metres, W,H,D (x, y up, z)")
+    return values[0], values[1], values[2]
+
+
+def run_retarget(args) -> int:
+    try:
+        size = parse_size(args.size)
+        check_order(args.order)
+    except (ValueError, BgrError) as e:
+        print(f"bgr retarget: {e}", file=sys.stderr)
+        return USAGE
+    out = None if args.output in (None, "-") else Path(args.output)
+    source = Path(args.input)
+    root = read(source)
+    result = retarget(root, size, args.order)
+    kept, total = alignments(root, result)
+    if out is None or out.name.lower().endswith(".json") and not _mesh_json(out):
+        text = dumps(result)
+        if out is None:
+            sys.stdout.write(text)
+        else:
+            write_atomic(out, text)
+    else:
+        save_mesh(result, source.parent, out)
+    boxes = sum(1 for _ in result.walk())
+    print(
+        f"{args.output or '<stdout>'}: {boxes} boxes ({sum(1 for _ in root.walk())} in the input), "
+        f"{_size(result)}; {kept} of {total} alignments kept",
+        file=sys.stderr,
+    )
+    return 0
+
+
+def _mesh_json(path: Path) -> bool:
+    return path.name.lower().endswith(".city.json")
+
+
+def _size(box: Box) -> str:
+    return " x ".join(f"{v:g}" for v in box.size) + " m"
+
+
+def save_mesh(result: Box, base: Path, out: Path) -> None:
+    """Each box with a mesh gets its part fitted; each leaf without one, a cube (labelled with
+    the box's source id), written by extension like bgr derive's outputs."""
+    from bgr.formats import write as write_table
+    from bgr.interpreter.geometry.meshes import primitive
+    from bgr.interpreter.terminals import TerminalTable, UnitMesh
+
+    table = TerminalTable()
+    parts: dict[str, int] = {}
+    cube = table.library.add(UnitMesh("cube", *primitive("cube")))
+    for box in result.walk():
+        if box.children and not box.mesh:
+            continue
+        if box.mesh:
+            if box.mesh not in parts:
+                parts[box.mesh] = table.library.add(_load_part(base, box.mesh))
+            mesh = parts[box.mesh]
+        else:
+            mesh = cube
+        table.label.append(box.source)
+        table.rule.append(box.source)
+        table.path.append(box.id)
+        table.origin.append(box.lo.tolist())
+        table.axes.append(np.eye(3).tolist())
+        table.size.append(box.size.tolist())
+        table.color.append(_colour(box))
+        table.material.append(None)
+        table.mesh.append(mesh)
+    table.freeze()
+    write_table(table, out, seed=0, attrs={})
+
+
+def _load_part(base: Path, mesh: str):
+    import trimesh
+
+    from bgr.interpreter.terminals import UnitMesh
+
+    path = base / mesh
+    if not path.is_file():
+        raise BgrError(f"mesh '{mesh}' not found (looked for {path})")
+    try:
+        loaded: Any = trimesh.load(path, force="mesh")
+        verts = np.asarray(loaded.vertices, dtype=np.float64)
+        faces = np.asarray(loaded.faces)
+    except Exception as e:  # any reader failure is the file's fault
+        raise BgrError(f"cannot read mesh '{mesh}': {e}") from None
+    if len(verts) == 0:
+        raise BgrError(f"mesh '{mesh}' has no geometry")
+    lo, hi = verts.min(axis=0), verts.max(axis=0)
+    unit = (verts - lo) / np.where(hi - lo > 0, hi - lo, 1.0)
+    return UnitMesh(Path(mesh).stem, unit, faces)
+
+
+PART_COLOURS = {  # parts named like these get a colour that reads as what they are
+    "window": (0.84, 0.78, 0.68),
+    "shop": (0.66, 0.72, 0.76),
+    "door": (0.36, 0.26, 0.20),
+    "porch": (0.70, 0.70, 0.68),
+}
+
+
+def _colour(box: Box) -> tuple[float, float, float]:
+    """A part's colour by its mesh's name, else a stable wall-like tone per source id."""
+    import zlib
+
+    if box.mesh:
+        for word, rgb in PART_COLOURS.items():
+            if word in Path(box.mesh).stem.lower():
+                return rgb
+    tones = [(0.80, 0.74, 0.64), (0.74, 0.60, 0.50), (0.70, 0.68, 0.62), (0.84, 0.80, 0.72)]
+    return tones[zlib.crc32(re.sub(r"[-_~]?\d+", "", box.source).encode()) % len(tones)]
+
+
+# ---- infer -------------------------------------------------------------------------------
+
+
+def run_infer(args) -> int:
+    source = Path(args.input)
+    root = read(source)
+    out = None if args.output in (None, "-") else Path(args.output)
+    written = write(root, str(args.input), source.parent, (out or Path("x")).parent)
+    text = format_module(written.module)
+    if out is None:
+        sys.stdout.write(text)
+    else:
+        write_atomic(out, text)
+    report = compare(root, out or Path.cwd() / "stdout.bgr")
+    how = "exact" if written.exact else "approximate"
+    print(
+        f"{args.output or '<stdout>'}: {len(written.module.rules())} rules, {how}; {report}",
+        file=sys.stderr,
+    )
+    return 0
+
+
+def compare(root: Box, where: Path) -> str:
+    """How the grammar does against bgr retarget at CHECK_SCALES of the input's size: the
+    sizes where it gives the same boxes, and the alignments each keeps."""
+    sizes = [
+        tuple(v * scale if t != "F" else v for v, t in zip(root.size, root.tags, strict=True))
+        for scale in CHECK_SCALES
+    ]
+    named = write(root, "", where.parent, where.parent, labels=True)
+    grammar = _loaded(format_module(named.module), where)
+    same = mine = theirs = total = 0
+    for size in sizes:
+        try:
+            target = retarget(root, size)
+            derived = derive_boxes(grammar, named.runs, size, root)
+        except BgrError as e:
+            return f"not checked against bgr retarget ({e.message})"
+        a, t = alignments(root, target)
+        b, _ = alignments(root, derived)
+        theirs, mine, total = theirs + a, mine + b, total + t
+        same += _same_leaves(target, derived)
+    shown = ", ".join("x".join(f"{v:g}" for v in s) for s in sizes)
+    where_same = "at all" if same == len(sizes) else f"at {same} of"
+    return (
+        f"checked at {shown} m: bgr retarget's boxes {where_same} {len(sizes)} sizes; "
+        f"{mine} of {total} alignments kept (bgr retarget: {theirs})"
+    )
+
+
+def derive_boxes(grammar, runs: set[str], size, root: Box) -> Box:
+    """The boxes a grammar written with ``labels=True`` derives at ``size``, as a flat
+    hierarchy under ``root``'s id: each named by the input box it is, copies (a repeat index
+    above 0 under a run rule) as copies."""
+    import bgr
+
+    result = bgr.derive(grammar, attrs=dict(zip(ATTRS, (float(v) for v in size), strict=True)))
+    t = result.terminals.freeze()
+    out = Box(root.id, root.lo.copy(), root.lo + np.asarray(size, dtype=float), root.tags)
+    for k, (label, path) in enumerate(zip(t.label, t.path, strict=True)):
+        steps = path.split("/")
+        copy = any(
+            prev.rsplit(".", 1)[0] in runs and not step.endswith(".0")
+            for prev, step in zip(steps, steps[1:], strict=False)
+        )
+        lo, hi = t.origin[k].copy(), t.origin[k] + t.size[k]
+        out.children.append(
+            Box(f"{label}~{k}" if copy else label, lo, hi, source=label, replica=int(copy))
+        )
+    return out
+
+
+def _loaded(text: str, where: Path):
+    """The grammar ``text`` loaded as if it were the file ``where`` (its assets resolve)."""
+    import tempfile
+
+    import bgr
+
+    with tempfile.NamedTemporaryFile(
+        "w", suffix=".bgr", dir=where.parent, delete=False, encoding="utf-8"
+    ) as f:
+        f.write(text)
+    try:
+        return bgr.load(f.name)
+    finally:
+        Path(f.name).unlink()
+
+
+def _same_leaves(a: Box, b: Box) -> bool:
+    def leaves(box):
+        rows = [(*x.lo, *x.hi) for x in box.walk() if not x.children or x.mesh]
+        return np.array(sorted(np.round(rows, 6).tolist()))
+
+    la, lb = leaves(a), leaves(b)
+    return la.shape == lb.shape and bool(np.allclose(la, lb, atol=1e-6))
+
+
+__all__ = ["run_retarget", "run_infer", "parse_size", "AXES"]

@@ -1,0 +1,224 @@
+"""Box hierarchies: the JSON a modeller writes, read and checked, and written back.
+
+A box is an axis-aligned box (``lo``/``hi`` corners, y up) with a behaviour per axis — ``S``
+scalable, ``R`` replicable, ``F`` fixed — an optional mesh fitted to it, and children that
+tessellate it without overlap (docs/inverse-boxes.md has the format).  Retargeting makes copies
+of replicable boxes: a copy keeps its ``source`` id and gets a ``replica`` number, and its own
+unique ``id`` so that a retargeted hierarchy is itself valid input.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from collections.abc import Iterator
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from bgr.grammar.errors import BgrError
+
+AXES = "xyz"
+BEHAVIOURS = ("S", "R", "F")
+EPS = 1e-6  # metres: faces closer than this coincide (the paper's epsilon-precision)
+
+
+@dataclass
+class Box:
+    id: str
+    lo: np.ndarray  # (3,) float64, the min corner
+    hi: np.ndarray  # (3,) float64, the max corner
+    tags: tuple[str, str, str] = ("S", "S", "S")  # behaviour along x, y, z
+    mesh: str | None = None
+    children: list[Box] = field(default_factory=list)
+    source: str = ""  # the id of the input box this one is (a copy of)
+    replica: int = 0  # 0 for the box itself, k for its k-th copy
+
+    def __post_init__(self) -> None:
+        self.source = self.source or self.id
+
+    @property
+    def size(self) -> np.ndarray:
+        return self.hi - self.lo
+
+    def walk(self) -> Iterator[Box]:
+        """This box and every descendant, depth first, children in order."""
+        yield self
+        for child in self.children:
+            yield from child.walk()
+
+    def leaves(self) -> Iterator[Box]:
+        return (b for b in self.walk() if not b.children)
+
+    def copy(self) -> Box:
+        return Box(
+            self.id,
+            self.lo.copy(),
+            self.hi.copy(),
+            self.tags,
+            self.mesh,
+            [c.copy() for c in self.children],
+            self.source,
+            self.replica,
+        )
+
+    def shift(self, axis: int, by: float) -> None:
+        """Move this box and its descendants along ``axis``."""
+        for b in self.walk():
+            b.lo[axis] += by
+            b.hi[axis] += by
+
+    def to_json(self) -> dict:
+        out: dict = {"id": self.id}
+        if self.source != self.id or self.replica:
+            out["source"], out["replica"] = self.source, self.replica
+        out["min"] = [_num(v) for v in self.lo]
+        out["max"] = [_num(v) for v in self.hi]
+        out["behavior"] = dict(zip(AXES, self.tags, strict=True))
+        if self.mesh is not None:
+            out["mesh"] = self.mesh
+        out["children"] = [c.to_json() for c in self.children]
+        return out
+
+
+def _num(v: float) -> float | int:
+    """Coordinates as written: 12 rather than 12.000000000000002 (rounded to 1e-9 m)."""
+    r = round(float(v), 9)
+    return int(r) if r == int(r) and abs(r) < 2**53 else r
+
+
+def dumps(root: Box) -> str:
+    return json.dumps({"root": root.to_json()}, indent=1) + "\n"
+
+
+# ---- reading -------------------------------------------------------------------------------
+
+
+def read(path: str | Path) -> Box:
+    """The hierarchy in a boxes JSON file, checked (:func:`parse`)."""
+    path = Path(path)
+    try:
+        text = path.read_bytes().decode("utf-8")
+    except FileNotFoundError:
+        raise BgrError(f"{path}: no such file") from None
+    except IsADirectoryError:
+        raise BgrError(f"{path}: is a folder, not a boxes .json file") from None
+    except UnicodeDecodeError as e:
+        raise BgrError(f"{path}: not UTF-8 text (byte {e.start})") from None
+    except OSError as e:
+        raise BgrError(f"{path}: cannot read: {e.strerror}") from None
+    return parse(text, str(path))
+
+
+def parse(text: str, name: str = "<boxes>") -> Box:
+    """Parse and check a boxes document; a BgrError naming the file, the line and the ids at
+    fault for anything a retargeting could not use."""
+    try:
+        doc = json.loads(text, parse_constant=_no_constant)
+    except json.JSONDecodeError as e:
+        raise BgrError(f"{name}:{e.lineno}:{e.colno}: not JSON: {e.msg}") from None
+    except ValueError as e:
+        raise BgrError(f"{name}: {e}") from None
+    except RecursionError:
+        raise BgrError(f"{name}: nested too deeply to read") from None
+    if not isinstance(doc, dict) or not isinstance(doc.get("root"), dict):
+        raise BgrError(
+            f'{name}: a boxes file is an object with a "root" box: '
+            '{"root": {"id": ..., "min": [x, y, z], "max": [x, y, z], "children": [...]}}'
+        )
+    ids: dict[str, str] = {}
+    root = _box(doc["root"], name, "root", ids, fixed=(False, False, False))
+    problems = check(root)
+    if problems:
+        more = f" (and {len(problems) - 5} more)" if len(problems) > 5 else ""
+        raise BgrError(f"{name}: " + "; ".join(problems[:5]) + more)
+    return root
+
+
+def _no_constant(word: str):
+    raise ValueError(f"{word} is not a number a box may have")
+
+
+def _box(obj, name: str, where: str, ids: dict, fixed: tuple[bool, bool, bool]) -> Box:
+    if not isinstance(obj, dict):
+        raise BgrError(f"{name}: {where} is not a box object")
+    box_id = obj.get("id")
+    if not isinstance(box_id, str) or not box_id.strip():
+        raise BgrError(f'{name}: {where} has no "id" (a non-empty string)')
+    here = f"box '{box_id}'"
+    if box_id in ids:
+        raise BgrError(f"{name}: two boxes have the id '{box_id}' ({ids[box_id]} and {where})")
+    ids[box_id] = where
+    unknown = set(obj) - {"id", "min", "max", "behavior", "mesh", "children", "source", "replica"}
+    if unknown:
+        raise BgrError(
+            f"{name}: {here} has unknown key(s) {', '.join(sorted(unknown))}; a box has id, min, "
+            "max, behavior, mesh and children"
+        )
+    corners = []
+    for key in ("min", "max"):
+        v = obj.get(key)
+        if (
+            not isinstance(v, list)
+            or len(v) != 3
+            or not all(isinstance(c, int | float) and not isinstance(c, bool) for c in v)
+        ):
+            raise BgrError(f'{name}: {here}: "{key}" must be three numbers [x, y, z]')
+        if not all(math.isfinite(c) and abs(c) < 1e9 for c in v):
+            raise BgrError(f'{name}: {here}: "{key}" holds a number that is not finite')
+        corners.append(np.array(v, dtype=np.float64))
+    lo, hi = corners
+    if np.any(hi - lo <= EPS):
+        axis = AXES[int(np.argmax(hi - lo <= EPS))]
+        raise BgrError(
+            f"{name}: {here}: max must exceed min on every axis (along {axis}: "
+            f"{lo[AXES.index(axis)]:g} to {hi[AXES.index(axis)]:g})"
+        )
+    behavior = obj.get("behavior", {})
+    if not isinstance(behavior, dict):
+        raise BgrError(f'{name}: {here}: "behavior" must be an object such as {{"x": "R"}}')
+    tags = []
+    for i, axis in enumerate(AXES):
+        tag = behavior.get(axis, "F" if fixed[i] else "S")
+        if tag not in BEHAVIOURS:
+            raise BgrError(
+                f"{name}: {here}: behavior {axis} is {json.dumps(tag)}; write S (scale), "
+                "R (replicate) or F (fixed)"
+            )
+        # an F box's descendants keep their size along that axis whatever they say
+        tags.append("F" if fixed[i] else tag)
+    extra = set(behavior) - set(AXES)
+    if extra:
+        raise BgrError(f"{name}: {here}: behavior has axis {sorted(extra)[0]!r}; use x, y, z")
+    mesh = obj.get("mesh")
+    if mesh is not None and (not isinstance(mesh, str) or not mesh.strip()):
+        raise BgrError(f'{name}: {here}: "mesh" must be a file path')
+    children = obj.get("children", [])
+    if not isinstance(children, list):
+        raise BgrError(f'{name}: {here}: "children" must be a list of boxes')
+    now = (tags[0] == "F", tags[1] == "F", tags[2] == "F")
+    kids = [_box(c, name, f"child {k} of '{box_id}'", ids, now) for k, c in enumerate(children)]
+    return Box(box_id, lo, hi, (tags[0], tags[1], tags[2]), mesh, kids)
+
+
+def check(root: Box, eps: float = EPS) -> list[str]:
+    """What makes a hierarchy invalid: children outside their parent, overlapping siblings,
+    negative sizes.  Retargeting results are checked with this too."""
+    problems = []
+    for box in root.walk():
+        if np.any(box.hi - box.lo < -eps):
+            problems.append(f"box '{box.id}' has a negative size")
+        for child in box.children:
+            if np.any(child.lo < box.lo - eps) or np.any(child.hi > box.hi + eps):
+                problems.append(f"box '{child.id}' is not inside its parent '{box.id}'")
+        if len(box.children) > 1:
+            lo = np.array([c.lo for c in box.children])
+            hi = np.array([c.hi for c in box.children])
+            # overlap of every pair on every axis, more than eps
+            over = np.minimum(hi[:, None], hi[None]) - np.maximum(lo[:, None], lo[None])
+            both = np.all(over > eps, axis=2)
+            for i, j in zip(*np.nonzero(np.triu(both, 1)), strict=True):
+                a, b = box.children[i], box.children[j]
+                problems.append(f"boxes '{a.id}' and '{b.id}' overlap")
+    return problems

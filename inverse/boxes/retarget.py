@@ -1,0 +1,349 @@
+"""The online retargeting of a box hierarchy (Lin et al. 2011, section 6 and Algorithm 1).
+
+One axis at a time, in the order asked for (the result depends on it: the paper's Figure 12).
+For an axis, the hierarchy is analysed (:mod:`.analysis`) and walked depth first: at each node,
+its sequences are retargeted in order, each followed by the recursive retargeting of its boxes.
+
+A sequence gets the length between its anchors (the node's ends for the primary; for a
+secondary, the boxes of earlier sequences it rests on and that rest on it, where they have moved
+to) and distributes the change over its units in a cascade (:func:`cascade`): replicable units
+first, taller first, each repeated ``floor(sigma'/sigma)`` times with the unused length passed
+on; what is left goes to the scalable units in proportion; if there are none, the replicable
+units are scaled.  Fixed units never change.  A contraction deletes instead of repeating, and a
+deleted box keeps its place with no length (virtual deletion) until the output drops it.
+
+The units are then placed from the bottom up.  A face goes where, in order of precedence, its
+attachment puts it (the anchors; and any box of an earlier sequence it touched in the input: a
+tessellation's neighbours must not come apart or overlap), then where its alignment group was
+put by the first face of the group placed (a soft constraint: kept only if no box gets a negative
+length, no fixed box must resize, and the rest of the sequence still fits), else where the
+distributed lengths put it.  A run of fixed units is skipped: the face below it moves so that the
+run's top lands aligned.
+"""
+
+from __future__ import annotations
+
+import math
+from bisect import bisect_left
+from collections.abc import Sequence as Seq
+from dataclasses import dataclass
+
+import numpy as np
+
+from bgr.grammar.errors import BgrError
+
+from .analysis import Analysis, Sequence, Unit, analyse, min_length
+from .model import AXES, EPS, Box
+
+NUDGE = 1e-9  # floor(x + NUDGE): 2.9999999999 repeats are 3 (the grammar writes the same)
+
+
+def retarget(root: Box, size: Seq[float], order: str = "xyz") -> Box:
+    """A retargeted copy of ``root`` whose size is ``size`` (x, y, z), one axis at a time in
+    ``order`` (any arrangement of "xyz"; axes left out keep their size)."""
+    check_order(order)
+    out = root.copy()
+    for name in order:
+        axis = AXES.index(name)
+        out = retarget_axis(out, axis, float(size[axis]))
+    return out
+
+
+def check_order(order: str) -> None:
+    if not order or set(order) - set(AXES) or len(set(order)) != len(order):
+        raise BgrError(f"--order {order!r}: write the axes to retarget in turn, such as xyz or yx")
+
+
+def retarget_axis(root: Box, axis: int, length: float, analysis: Analysis | None = None) -> Box:
+    """``root`` (changed in place and returned) resized to ``length`` along ``axis``."""
+    name = AXES[axis]
+    if not (math.isfinite(length) and length > 0):
+        raise BgrError(f"the size along {name} must be a length over 0 m (got {length:g})")
+    now = float(root.size[axis])
+    if abs(length - now) <= EPS:
+        return root
+    if root.tags[axis] == "F":
+        raise BgrError(
+            f"box '{root.id}' is fixed (F) along {name}: it stays {now:g} m; "
+            f"give --size with {now:g} for {name}, or tag the root S"
+        )
+    shortest = min_length(root, axis)
+    if length < shortest - EPS:
+        raise BgrError(
+            f"the fixed boxes along {name} need at least {shortest:g} m; {length:g} m is shorter"
+        )
+    Retargeter(root, axis, analysis or analyse(root, axis)).resize(
+        root, float(root.lo[axis]), float(root.lo[axis]) + length
+    )
+    return root
+
+
+@dataclass
+class Placed:
+    lo: float
+    hi: float
+    count: int  # copies (1: the box alone; 0: deleted)
+
+
+class Retargeter:
+    def __init__(self, root: Box, axis: int, analysis: Analysis) -> None:
+        self.axis = axis
+        self.analysis = analysis
+        groups = sorted(analysis.groups.items(), key=lambda kv: kv[1][0])
+        self.group_ids = [g for g, _ in groups]
+        self.group_pos = [p for _, (p, _) in groups]
+        self.aligned: dict[int, float] = {}  # alignment index -> where its first face went
+        self.mins: dict = {}
+        self.taken = {b.id for b in root.walk()}  # ids in use: a copy gets a fresh one
+
+    # ---- alignment ---------------------------------------------------------------------
+    def group(self, position: float) -> int | None:
+        k = bisect_left(self.group_pos, position - EPS)
+        if k < len(self.group_pos) and abs(self.group_pos[k] - position) <= EPS:
+            return self.group_ids[k]
+        return None
+
+    def mark(self, position: float, new: float) -> None:
+        g = self.group(position)
+        if g is not None and g not in self.aligned:
+            self.aligned[g] = new
+
+    # ---- the walk ----------------------------------------------------------------------
+    def resize(self, box: Box, lo: float, hi: float) -> None:
+        a = self.axis
+        if box.tags[a] == "F":
+            box.shift(a, lo - box.lo[a])
+            return
+        if not box.children:
+            box.lo[a], box.hi[a] = lo, hi
+            return
+        node = self.analysis.of(box)
+        kids = box.children
+        old_lo = np.array([c.lo[a] for c in kids])
+        old_hi = np.array([c.hi[a] for c in kids])
+        ends = (float(box.lo[a]), float(box.hi[a]))
+        box.lo[a], box.hi[a] = lo, hi
+        placed: dict[int, Placed] = {}
+        copies: dict[int, list[Box]] = {}
+        for seq in node.sequences:
+            self.place(seq, kids, node.touch, old_lo, old_hi, ends, (lo, hi), placed)
+            for i in seq.boxes:
+                p = placed[i]
+                if p.count == 0:
+                    continue
+                step = (p.hi - p.lo) / p.count
+                self.resize(kids[i], p.lo, p.lo + step)
+                copies[i] = [self.replicate(kids[i], c * step, c) for c in range(1, p.count)]
+        box.children = [
+            b for i, k in enumerate(kids) if placed[i].count > 0 for b in [k, *copies[i]]
+        ]
+
+    def replicate(self, box: Box, by: float, number: int) -> Box:
+        """Copy ``number`` of a resized box, ``by`` further along the axis, with fresh ids."""
+        out = box.copy()
+        out.shift(self.axis, by)
+        for b in out.walk():
+            k = 1
+            while f"{b.source}~{k}" in self.taken:
+                k += 1
+            b.id = f"{b.source}~{k}"
+            self.taken.add(b.id)
+            b.replica = number
+        return out
+
+    def unit_min(self, unit: Unit, kids: list[Box]) -> float:
+        """The shortest one copy of a unit can be made without deleting it."""
+        if unit.tag == "F":
+            return unit.length
+        return max((min_length(kids[i], self.axis, self.mins) for i in unit.boxes), default=0.0)
+
+    # ---- one sequence ------------------------------------------------------------------
+    def place(self, seq: Sequence, kids, touch, old_lo, old_hi, ends, new_ends, placed) -> None:
+        units = list(seq.units)
+        if seq.below:
+            start_old = max(old_hi[j] for j in seq.below)
+            start = max(placed[j].hi for j in seq.below)
+        else:
+            start_old, start = ends[0], new_ends[0]
+        if seq.above:
+            end_old = min(old_lo[j] for j in seq.above)
+            end = min(placed[j].lo for j in seq.above)
+        else:
+            end_old, end = ends[1], new_ends[1]
+        # empty space between an anchor and the sequence scales like an S box
+        if units[0].lo - start_old > EPS:
+            units.insert(0, Unit([], start_old, units[0].lo, "S"))
+        if end_old - units[-1].hi > EPS:
+            units.append(Unit([], units[-1].hi, end_old, "S"))
+        mins = [self.unit_min(u, kids) for u in units]
+        counts, lengths = cascade(units, mins, end - start)
+        members = set(seq.boxes)
+        pos = start
+        for k, unit in enumerate(units):
+            if k == len(units) - 1:
+                top = end if unit.tag != "F" and counts[k] > 0 else pos + lengths[k]
+            elif unit.tag == "F" or counts[k] == 0:
+                top = pos + lengths[k]
+            else:
+                top = pos + lengths[k]
+                want = self.wanted(units, k, kids, touch, old_lo, old_hi, placed, members)
+                if (
+                    want is not None
+                    and abs(want - top) > EPS
+                    and self.fits(units, mins, counts, k, pos, want, end)
+                ):
+                    top = want
+                    rest = cascade(units[k + 1 :], mins[k + 1 :], end - top)
+                    counts[k + 1 :], lengths[k + 1 :] = rest
+            for i in unit.boxes:
+                placed[i] = Placed(pos, top, counts[k])
+                if counts[k]:
+                    self.mark(old_lo[i], pos)
+                    self.mark(old_hi[i], top)
+            pos = top
+
+    def wanted(self, units, k, kids, touch, old_lo, old_hi, placed, members) -> float | None:
+        """Where the top of unit ``k`` should go for an attachment or an alignment: its own top
+        face's, or that of the run of fixed units above it, less the run's length."""
+        offset = 0.0
+        j = k
+        while j < len(units) - 1:
+            at = self.boundary(units[j], units[j + 1], kids, touch, old_lo, old_hi, placed, members)
+            if at is not None:
+                return at - offset
+            if units[j + 1].tag != "F":
+                return None
+            offset += units[j + 1].length
+            j += 1
+        return None
+
+    def boundary(self, below, above, kids, touch, old_lo, old_hi, placed, members):
+        """Where the face between two units must go: on the boxes of earlier sequences it
+        touched (attachment), else at its alignment group's position, else None."""
+        under = [
+            placed[j].hi
+            for i in above.boxes
+            for j in np.nonzero(touch[:, i])[0]
+            if j not in members and j in placed and placed[j].count
+        ]
+        if under:
+            return max(under)
+        over = [
+            placed[j].lo
+            for i in below.boxes
+            for j in np.nonzero(touch[i, :])[0]
+            if j not in members and j in placed and placed[j].count
+        ]
+        if over:
+            return min(over)
+        g = self.group(below.hi)
+        return self.aligned.get(g) if g is not None else None
+
+    @staticmethod
+    def fits(units, mins, counts, k, pos, want, end) -> bool:
+        """Whether unit k may end at ``want``: no negative or below-minimum length, and the
+        units above can still fill up to the end without resizing a fixed one."""
+        length = want - pos
+        if length < -EPS or length < (mins[k] * counts[k]) - EPS:
+            return False
+        rest = units[k + 1 :]
+        room = end - want
+        if all(u.tag == "F" for u in rest):
+            return abs(room - sum(u.length for u in rest)) <= EPS
+        need = sum(
+            u.length if u.tag == "F" else (0.0 if u.tag == "R" else m)
+            for u, m in zip(rest, mins[k + 1 :], strict=True)
+        )
+        return room >= need - EPS
+
+
+def cascade(units: list[Unit], mins: list[float], length: float) -> tuple[list[int], list[float]]:
+    """Copies and lengths of each unit when the units together are to take ``length``.
+
+    The change goes to the R units first, taller first (ties: lower first), each getting its
+    share in proportion to its length plus what the previous one left, and repeated (or
+    deleted) ``floor(share / length)`` times; the rest goes to the S units in proportion, none
+    going below its minimum; what no S unit can take scales the R units left.  F units keep
+    their length, so the sum may differ from ``length`` when nothing can take the change.
+    """
+    m = len(units)
+    counts = [1] * m
+    lengths = [u.length for u in units]
+    change = length - sum(lengths)
+    rs = sorted((k for k in range(m) if units[k].tag == "R"), key=lambda k: (-units[k].length, k))
+    total = sum(units[k].length for k in rs)
+    used = 0.0
+    if rs and total > 0:
+        covered = 0.0  # the R lengths so far: this box's share is change * covered / total
+        for k in rs:
+            sigma = units[k].length
+            covered += sigma
+            share = change * covered / total if covered < total else change
+            extra = repeats((share - used) / sigma)
+            used += extra * sigma
+            counts[k] = 1 + extra
+            lengths[k] = counts[k] * sigma
+    rest = change - used
+    free = [k for k in range(m) if units[k].tag == "S"]
+    while free and abs(rest) > EPS * 1e-3:
+        weight = sum(units[k].length for k in free)
+        clamped = [k for k in free if lengths[k] + rest * units[k].length / weight < mins[k] - EPS]
+        if not clamped:
+            for k in free:
+                lengths[k] += rest * units[k].length / weight
+            rest = 0.0
+            break
+        for k in clamped:
+            rest -= mins[k] - lengths[k]
+            lengths[k] = mins[k]
+            free.remove(k)
+    if abs(rest) > EPS * 1e-3:
+        scalable = [k for k in rs if counts[k] > 0]
+        weight = sum(lengths[k] for k in scalable)
+        for k in scalable:
+            lengths[k] = max(lengths[k] + rest * lengths[k] / weight, counts[k] * mins[k])
+    return counts, lengths
+
+
+def repeats(x: float) -> int:
+    """How many more copies (negative: deletions) a share of ``x`` lengths buys: floor toward
+    zero, and at most one deletion (a box is deleted once)."""
+    n = math.floor(x + NUDGE) if x >= 0 else -math.floor(-x + NUDGE)
+    return max(n, -1)
+
+
+# ---- measuring a result -----------------------------------------------------------------
+
+
+def alignments(source: Box, result: Box, axis: int | None = None) -> tuple[int, int]:
+    """(kept, total): pairs of input leaves with a face in the same alignment group, whose
+    faces still line up in ``result`` (the leaves of the same ids, copies left aside)."""
+    axes = range(3) if axis is None else [axis]
+    placed = {b.id: b for b in result.leaves() if b.replica == 0 and "~" not in b.id}
+    kept = total = 0
+    for a in axes:
+        groups = analyse_groups(source, a)
+        for members in groups:
+            alive = [(b, side) for b, side in members if b.id in placed]
+            total += len(members) - 1
+            if len(alive) < 2:
+                continue
+            where = [(placed[b.id].lo if side == 0 else placed[b.id].hi)[a] for b, side in alive]
+            ref = where[0]
+            kept += sum(1 for w in where[1:] if abs(w - ref) <= 1e-6)
+    return kept, total
+
+
+def analyse_groups(root: Box, axis: int) -> list[list[tuple[Box, int]]]:
+    """The leaf faces of each alignment group of ``root`` along ``axis``: (box, 0 lo / 1 hi)."""
+    from .analysis import alignment_groups
+
+    groups = alignment_groups(root, axis)
+    out: list[list[tuple[Box, int]]] = [[] for _ in groups]
+    index = {g: k for k, g in enumerate(groups)}
+    for leaf in root.leaves():
+        for side, where in ((0, leaf.lo[axis]), (1, leaf.hi[axis])):
+            for g, (p, _) in groups.items():
+                if abs(p - where) <= EPS:
+                    out[index[g]].append((leaf, side))
+    return out
