@@ -164,7 +164,8 @@ def analyse_node(box: Box, axis: int) -> NodeAnalysis:
     edges = [(int(i), int(j)) for i, j in zip(*np.nonzero(edge), strict=True)]
     succ: list[list[int]] = [[] for _ in range(n)]
     for i, j in edges:
-        succ[i].append(j)
+        if rank[i] < rank[j]:  # degenerate (zero-length) boxes could otherwise make a cycle
+            succ[i].append(j)
     for s in succ:
         s.sort(key=lambda j: rank[j])
 

@@ -156,7 +156,7 @@ def run_infer(args) -> int:
         sys.stdout.write(text)
     else:
         write_atomic(out, text)
-    report = compare(root, out or Path.cwd() / "stdout.bgr")
+    report = compare(root, out or Path.cwd() / "stdout.bgr", source.parent)
     how = "exact" if written.exact else "approximate"
     print(
         f"{args.output or '<stdout>'}: {len(written.module.rules())} rules, {how}; {report}",
@@ -165,15 +165,15 @@ def run_infer(args) -> int:
     return 0
 
 
-def compare(root: Box, where: Path) -> str:
+def compare(root: Box, where: Path, base: Path) -> str:
     """How the grammar does against bgr retarget at CHECK_SCALES of the input's size: the
     sizes where it gives the same boxes, and the alignments each keeps."""
     sizes = [
         tuple(v * scale if t != "F" else v for v, t in zip(root.size, root.tags, strict=True))
         for scale in CHECK_SCALES
     ]
-    named = write(root, "", where.parent, where.parent, labels=True)
-    grammar = _loaded(format_module(named.module), where)
+    named = write(root, "", base, where.parent, labels=True)
+    grammar = _loaded(format_module(named.module), where, base)
     same = mine = theirs = total = 0
     for size in sizes:
         try:
@@ -215,7 +215,7 @@ def derive_boxes(grammar, runs: set[str], size, root: Box) -> Box:
     return out
 
 
-def _loaded(text: str, where: Path):
+def _loaded(text: str, where: Path, base: Path):
     """The grammar ``text`` loaded as if it were the file ``where`` (its assets resolve)."""
     import tempfile
 
@@ -226,7 +226,7 @@ def _loaded(text: str, where: Path):
     ) as f:
         f.write(text)
     try:
-        return bgr.load(f.name)
+        return bgr.load(f.name, allow_paths=[str(base)])
     finally:
         Path(f.name).unlink()
 

@@ -125,10 +125,13 @@ class Retargeter:
         box.lo[a], box.hi[a] = lo, hi
         placed: dict[int, Placed] = {}
         copies: dict[int, list[Box]] = {}
+        room = self.room(kids, node.touch, old_lo)
         for seq in node.sequences:
-            self.place(seq, kids, node.touch, old_lo, old_hi, ends, (lo, hi), placed)
+            self.place(seq, kids, node.touch, old_lo, old_hi, ends, (lo, hi), placed, room)
             for i in seq.boxes:
                 p = placed[i]
+                if p.hi - p.lo <= EPS and kids[i].tags[a] != "F":
+                    p.count = 0  # squeezed to nothing: deleted, as a contraction deletes
                 if p.count == 0:
                     continue
                 step = (p.hi - p.lo) / p.count
@@ -158,8 +161,35 @@ class Retargeter:
         return max((min_length(kids[i], self.axis, self.mins) for i in unit.boxes), default=0.0)
 
     # ---- one sequence ------------------------------------------------------------------
-    def place(self, seq: Sequence, kids, touch, old_lo, old_hi, ends, new_ends, placed) -> None:
+    def room(self, kids: list[Box], touch, old_lo) -> tuple[list[float], list[float]]:
+        """For each child, the least length its stacks of neighbours need below and above it
+        (fixed boxes their length, S boxes their minimum, R boxes nothing: they can go), so
+        that a sequence never squeezes a box of a later sequence it does not contain."""
+        a = self.axis
+        need = [0.0 if k.tags[a] == "R" else min_length(k, a, self.mins) for k in kids]
+        order = sorted(range(len(kids)), key=lambda i: old_lo[i])
+        below = [0.0] * len(kids)
+        above = [0.0] * len(kids)
+        for i in order:
+            for j in np.nonzero(touch[:, i])[0]:
+                below[i] = max(below[i], below[j] + need[j])
+        for i in reversed(order):
+            for j in np.nonzero(touch[i, :])[0]:
+                above[i] = max(above[i], above[j] + need[j])
+        return below, above
+
+    def place(
+        self, seq: Sequence, kids, touch, old_lo, old_hi, ends, new_ends, placed, room
+    ) -> None:
         units = list(seq.units)
+        below_need, above_need = room
+
+        def low(j: int) -> float:  # the lowest the face above unit j may go
+            return new_ends[0] + max((below_need[i] for i in units[j + 1].boxes), default=0.0)
+
+        def high(j: int) -> float:  # the highest it may go
+            return new_ends[1] - max((above_need[i] for i in units[j].boxes), default=0.0)
+
         if seq.below:
             start_old = max(old_hi[j] for j in seq.below)
             start = max(placed[j].hi for j in seq.below)
@@ -185,14 +215,24 @@ class Retargeter:
             elif unit.tag == "F" or counts[k] == 0:
                 top = pos + lengths[k]
             else:
-                top = pos + lengths[k]
+                natural = top = pos + lengths[k]
+                # bounds on this unit's top, also through the run of fixed units above it
+                least, most, offset, j = low(k), high(k), 0.0, k
+                while j + 2 < len(units) and units[j + 1].tag == "F":
+                    offset += units[j + 1].length
+                    j += 1
+                    least, most = max(least, low(j) - offset), min(most, high(j) - offset)
                 want = self.wanted(units, k, kids, touch, old_lo, old_hi, placed, members)
                 if (
                     want is not None
                     and abs(want - top) > EPS
+                    and least - EPS <= want <= most + EPS
                     and self.fits(units, mins, counts, k, pos, want, end)
                 ):
                     top = want
+                elif top < least - EPS or (top > most + EPS and most >= least):
+                    top = max(pos, least if top < least else most)
+                if top != natural:
                     rest = cascade(units[k + 1 :], mins[k + 1 :], end - top)
                     counts[k + 1 :], lengths[k + 1 :] = rest
             for i in unit.boxes:
@@ -201,6 +241,20 @@ class Retargeter:
                     self.mark(old_lo[i], pos)
                     self.mark(old_hi[i], top)
             pos = top
+            if k + 1 < len(units):
+                # a box of an earlier sequence under the next unit ends higher (this unit could
+                # not reach it: fixed, or held by its bounds): leave a gap rather than overlap
+                under = [
+                    placed[j].hi
+                    for i in units[k + 1].boxes
+                    for j in np.nonzero(touch[:, i])[0]
+                    if j not in members and j in placed and placed[j].count
+                ]
+                if under and max(under) > pos + EPS:
+                    pos = max(under)
+                    counts[k + 1 :], lengths[k + 1 :] = cascade(
+                        units[k + 1 :], mins[k + 1 :], end - pos
+                    )
 
     def wanted(self, units, k, kids, touch, old_lo, old_hi, placed, members) -> float | None:
         """Where the top of unit ``k`` should go for an attachment or an alignment: its own top
