@@ -2,6 +2,7 @@
 model had 300 boxes: 1.5 min of analysis, under 1 s a retargeting).
 
     python bench/boxes.py [--storeys 6] [--repeat 7] [--seed 1]   # 6 storeys: 325 boxes
+    python bench/boxes.py --validity 99   # is every retargeting of 99 random façades valid?
 
 The hierarchy is an irregular façade: storeys (R up) of bays of random widths (R across, S
 walls between them, a fixed door in the ground storey), each bay a sill, a window and a lintel
@@ -13,6 +14,11 @@ and best of ``--repeat`` runs in this process:
 * **one retargeting**: one axis (x, to 150 %) from its analysis — the paper's interactive step;
 * **retarget x then y**: ``retarget()`` to 150 % x 130 %, re-analysing the grown hierarchy for y,
   as ``bgr retarget`` does.
+
+``--validity N`` instead retargets N random façades (seeds 1..N: 3 to 8 storeys, each axis to
+60 %, 80 %, 150 % or 250 %, order xy or yx) and counts the results that are valid hierarchies of
+the size asked, the sizes refused (shorter than the fixed boxes need), and the nodes whose
+placement had to be fitted (inverse/boxes/repair.py).
 """
 
 from __future__ import annotations
@@ -24,8 +30,12 @@ import random
 import statistics
 import time
 
+import numpy as np
+
+from bgr.grammar.errors import BgrError
+from bgr.inverse.boxes import retarget as retargeting
 from bgr.inverse.boxes.analysis import analyse
-from bgr.inverse.boxes.model import parse
+from bgr.inverse.boxes.model import check, parse
 from bgr.inverse.boxes.retarget import retarget, retarget_axis
 
 
@@ -79,12 +89,46 @@ def timed(fn, repeat: int) -> tuple[float, float]:
     return statistics.median(times), min(times)
 
 
+def validity(n: int) -> None:
+    fitted = 0
+    fit = retargeting.fit
+
+    def counting(*args):
+        nonlocal fitted
+        fitted += 1
+        return fit(*args)
+
+    retargeting.fit = counting
+    valid = invalid = refused = 0
+    for seed in range(1, n + 1):
+        rng = random.Random(seed)
+        root = parse(json.dumps(facade(rng.randint(3, 8), seed)))
+        factors = [rng.choice([0.6, 0.8, 1.5, 2.5]) for _ in range(2)]
+        size = (root.size[0] * factors[0], root.size[1] * factors[1], root.size[2])
+        try:
+            result = retarget(root, size, rng.choice(["xy", "yx"]))
+        except BgrError:
+            refused += 1
+            continue
+        if check(result) or not np.allclose(result.size, size):
+            invalid += 1
+        else:
+            valid += 1
+    retargeting.fit = fit
+    print(f"{n} random façades: {valid} valid, {invalid} invalid, {refused} refused (too short);")
+    print(f"{fitted} node placements fitted")
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--storeys", type=int, default=6)
     ap.add_argument("--repeat", type=int, default=7)
     ap.add_argument("--seed", type=int, default=1)
+    ap.add_argument("--validity", type=int, metavar="N", help="check N random retargetings")
     args = ap.parse_args()
+    if args.validity:
+        validity(args.validity)
+        return
     root = parse(json.dumps(facade(args.storeys, args.seed)))
     boxes = sum(1 for _ in root.walk())
     size = root.size

@@ -57,6 +57,7 @@ class NodeAnalysis:
     edges: list[tuple[int, int]]
     sequences: list[Sequence]
     touch: np.ndarray  # touch[i, j]: child j rests on child i across the axis
+    below: np.ndarray  # below[i, j]: child i under child j, their cross-sections overlapping
 
 
 @dataclass
@@ -127,6 +128,18 @@ def _contacts(lo: np.ndarray, hi: np.ndarray, axis: int) -> np.ndarray:
     return touch
 
 
+def _below(lo: np.ndarray, hi: np.ndarray, axis: int) -> np.ndarray:
+    """below[i, j]: box i lies under box j along ``axis``, their cross-sections overlapping
+    (so that i must stay under j whatever their lengths become)."""
+    others = [a for a in range(3) if a != axis]
+    out = (hi[:, None, axis] <= lo[None, :, axis] + EPS) & (lo[:, None, axis] < lo[None, :, axis])
+    for a in others:
+        out &= (
+            np.minimum(hi[:, None, a], hi[None, :, a]) - np.maximum(lo[:, None, a], lo[None, :, a])
+        ) > EPS
+    return out
+
+
 def analyse_node(box: Box, axis: int) -> NodeAnalysis:
     kids = box.children
     n = len(kids)
@@ -192,7 +205,7 @@ def analyse_node(box: Box, axis: int) -> NodeAnalysis:
         if hi[last, axis] >= top - EPS:
             above = []
         sequences.append(Sequence(units, below, above, primary=not sequences))
-    return NodeAnalysis(edges, sequences, up)
+    return NodeAnalysis(edges, sequences, up, _below(lo, hi, axis))
 
 
 def _lowest_and_highest(free, edge, lo, hi) -> tuple[list[int], list[int]]:
@@ -261,7 +274,10 @@ def _units(path: list[int], lo, hi, tags) -> list[Unit]:
 
 def min_length(box: Box, axis: int, memo: dict | None = None) -> float:
     """The shortest a box can become along ``axis``: its length when fixed, else the tallest
-    stack of its children's minimums (R children can be deleted, S leaves shrink to nothing)."""
+    stack of its children's minimums (R children can be deleted, S leaves shrink to nothing).
+
+    A stack is any chain of children each under the next with overlapping cross-sections,
+    touching or not: their order along the axis is kept whatever the lengths."""
     memo = {} if memo is None else memo
     key = id(box)
     if key in memo:
@@ -274,11 +290,11 @@ def min_length(box: Box, axis: int, memo: dict | None = None) -> float:
         kids = box.children
         lo = np.array([c.lo for c in kids])
         hi = np.array([c.hi for c in kids])
-        up = _contacts(lo, hi, axis)
+        under = _below(lo, hi, axis)
         need = [0.0 if c.tags[axis] == "R" else min_length(c, axis, memo) for c in kids]
         reach: dict[int, float] = {}
         for i in sorted(range(len(kids)), key=lambda i: lo[i, axis]):
-            below = [reach[int(j)] for j in np.nonzero(up[:, i])[0] if int(j) in reach]
+            below = [reach[int(j)] for j in np.nonzero(under[:, i])[0] if int(j) in reach]
             reach[i] = max(below, default=0.0) + need[i]
         out = max(reach.values(), default=0.0)
     memo[key] = out

@@ -136,8 +136,18 @@ def parse(text: str, name: str = "<boxes>") -> Box:
     return root
 
 
-def _no_constant(word: str):
-    raise ValueError(f"{word} is not a number a box may have")
+class _Constant:
+    """NaN, Infinity or -Infinity as read: kept as a marker so that the box holding it is named."""
+
+    def __init__(self, word: str) -> None:
+        self.word = word
+
+    def __str__(self) -> str:
+        return self.word
+
+
+def _no_constant(word: str) -> _Constant:
+    return _Constant(word)
 
 
 def _box(obj, name: str, where: str, ids: dict, fixed: tuple[bool, bool, bool]) -> Box:
@@ -159,6 +169,13 @@ def _box(obj, name: str, where: str, ids: dict, fixed: tuple[bool, bool, bool]) 
     corners = []
     for key in ("min", "max"):
         v = obj.get(key)
+        constant = (
+            next((c for c in v if isinstance(c, _Constant)), None) if isinstance(v, list) else None
+        )
+        if constant is not None:
+            raise BgrError(
+                f'{name}: {here}: "{key}" holds {constant}, which is not a number a box may have'
+            )
         if (
             not isinstance(v, list)
             or len(v) != 3
@@ -183,8 +200,8 @@ def _box(obj, name: str, where: str, ids: dict, fixed: tuple[bool, bool, bool]) 
         tag = behavior.get(axis, "F" if fixed[i] else "S")
         if tag not in BEHAVIOURS:
             raise BgrError(
-                f"{name}: {here}: behavior {axis} is {json.dumps(tag)}; write S (scale), "
-                "R (replicate) or F (fixed)"
+                f"{name}: {here}: behavior {axis} is {json.dumps(tag, default=str)}; "
+                "write S (scale), R (replicate) or F (fixed)"
             )
         # an F box's descendants keep their size along that axis whatever they say
         tags.append("F" if fixed[i] else tag)
@@ -197,9 +214,15 @@ def _box(obj, name: str, where: str, ids: dict, fixed: tuple[bool, bool, bool]) 
     children = obj.get("children", [])
     if not isinstance(children, list):
         raise BgrError(f'{name}: {here}: "children" must be a list of boxes')
+    source = obj.get("source", box_id)
+    replica = obj.get("replica", 0)
+    if not isinstance(source, str) or not source.strip():
+        raise BgrError(f'{name}: {here}: "source" must be the id of the box it is a copy of')
+    if not isinstance(replica, int) or isinstance(replica, bool) or replica < 0:
+        raise BgrError(f'{name}: {here}: "replica" must be a whole number, 0 or more')
     now = (tags[0] == "F", tags[1] == "F", tags[2] == "F")
     kids = [_box(c, name, f"child {k} of '{box_id}'", ids, now) for k, c in enumerate(children)]
-    return Box(box_id, lo, hi, (tags[0], tags[1], tags[2]), mesh, kids)
+    return Box(box_id, lo, hi, (tags[0], tags[1], tags[2]), mesh, kids, source, replica)
 
 
 def check(root: Box, eps: float = EPS) -> list[str]:

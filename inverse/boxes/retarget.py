@@ -26,7 +26,6 @@ from __future__ import annotations
 import math
 from bisect import bisect_left
 from collections.abc import Sequence as Seq
-from dataclasses import dataclass
 
 import numpy as np
 
@@ -34,6 +33,7 @@ from bgr.grammar.errors import BgrError
 
 from .analysis import Analysis, Sequence, Unit, analyse, min_length
 from .model import AXES, EPS, Box
+from .repair import Layout, Placed, fit, fits, valid
 
 NUDGE = 1e-9  # floor(x + NUDGE): 2.9999999999 repeats are 3 (the grammar writes the same)
 
@@ -78,13 +78,6 @@ def retarget_axis(root: Box, axis: int, length: float, analysis: Analysis | None
     return root
 
 
-@dataclass
-class Placed:
-    lo: float
-    hi: float
-    count: int  # copies (1: the box alone; 0: deleted)
-
-
 class Retargeter:
     def __init__(self, root: Box, axis: int, analysis: Analysis) -> None:
         self.axis = axis
@@ -122,24 +115,60 @@ class Retargeter:
         old_lo = np.array([c.lo[a] for c in kids])
         old_hi = np.array([c.hi[a] for c in kids])
         ends = (float(box.lo[a]), float(box.hi[a]))
+        layout = Layout(
+            old_lo,
+            old_hi,
+            [k.tags[a] for k in kids],
+            [float(k.size[a]) if k.tags[a] == "F" else min_length(k, a, self.mins) for k in kids],
+            node.below,
+            node.touch,
+            (lo, hi),
+            ends,
+        )
+        saved = [(b, float(b.lo[a]), float(b.hi[a]), b.children) for b in box.walk()]
         box.lo[a], box.hi[a] = lo, hi
         placed: dict[int, Placed] = {}
         copies: dict[int, list[Box]] = {}
         room = self.room(kids, node.touch, old_lo)
+        fitting = True  # no child placed out of the node or below its minimum so far
         for seq in node.sequences:
             self.place(seq, kids, node.touch, old_lo, old_hi, ends, (lo, hi), placed, room)
             for i in seq.boxes:
                 p = placed[i]
                 if p.hi - p.lo <= EPS and kids[i].tags[a] != "F":
                     p.count = 0  # squeezed to nothing: deleted, as a contraction deletes
-                if p.count == 0:
-                    continue
-                step = (p.hi - p.lo) / p.count
-                self.resize(kids[i], p.lo, p.lo + step)
-                copies[i] = [self.replicate(kids[i], c * step, c) for c in range(1, p.count)]
+                fitting = fitting and fits(layout, i, p)
+                if fitting:
+                    self.fill(kids, i, p, copies)
+        slots = [placed[i] for i in range(len(kids))]
+        if not (fitting and valid(layout, slots)):
+            # the placement left boxes overlapping or outside: undo it and fit (repair.py)
+            for b, was_lo, was_hi, children in saved:
+                b.lo[a], b.hi[a], b.children = was_lo, was_hi, children
+            box.lo[a], box.hi[a] = lo, hi
+            for i, p in enumerate(slots):
+                if p.count == 0 and kids[i].tags[a] == "S":
+                    p.count = 1  # squeezed by a placement that did not fit: may get room now
+            slots = fit(layout, slots)
+            copies = {}
+            for seq in node.sequences:
+                for i in seq.boxes:
+                    p = slots[i]
+                    if p.hi - p.lo <= EPS and kids[i].tags[a] != "F":
+                        p.count = 0
+                    self.fill(kids, i, p, copies)
         box.children = [
-            b for i, k in enumerate(kids) if placed[i].count > 0 for b in [k, *copies[i]]
+            b for i, k in enumerate(kids) if slots[i].count > 0 for b in [k, *copies[i]]
         ]
+
+    def fill(self, kids: list[Box], i: int, p: Placed, copies: dict[int, list[Box]]) -> None:
+        """Resize child ``i`` into its first copy's place and make the other copies."""
+        copies[i] = []
+        if p.count == 0:
+            return
+        step = (p.hi - p.lo) / p.count
+        self.resize(kids[i], p.lo, p.lo + step)
+        copies[i] = [self.replicate(kids[i], c * step, c) for c in range(1, p.count)]
 
     def replicate(self, box: Box, by: float, number: int) -> Box:
         """Copy ``number`` of a resized box, ``by`` further along the axis, with fresh ids."""
