@@ -782,6 +782,52 @@ def test_the_irregular_facade_below_its_fixed_storeys_exits_1(tmp_path, capsys):
     assert code == 1 and "need at least 4 m" in err and not out.exists()
 
 
+json_values = st.recursive(
+    st.none()
+    | st.booleans()
+    | st.integers(-5, 20)
+    | st.floats(allow_nan=True, allow_infinity=True)
+    | st.sampled_from(["S", "R", "F", "x", "", "root", "a"]),
+    lambda inner: (
+        st.lists(inner, max_size=4)
+        | st.dictionaries(
+            st.sampled_from(
+                ["id", "min", "max", "behavior", "children", "mesh", "x", "y", "source"]
+            ),
+            inner,
+            max_size=6,
+        )
+    ),
+    max_leaves=30,
+)
+
+
+@settings(max_examples=300, deadline=None, derandomize=True)
+@given(json_values)
+def test_any_json_under_root_is_read_or_refused_cleanly(value):
+    # whatever the "root" holds, reading gives a hierarchy or a BgrError, never another exception
+    text = json.dumps({"root": value}, allow_nan=True)
+    try:
+        model.parse(text)
+    except BgrError as e:
+        assert e.message
+
+
+@settings(max_examples=300, deadline=None, derandomize=True)
+@given(st.data())
+def test_a_valid_file_cut_or_changed_anywhere_is_read_or_refused_cleanly(data):
+    text = (EXAMPLES / "building.json").read_text()
+    at = data.draw(st.integers(0, len(text)))
+    cut = data.draw(st.integers(0, 12))
+    junk = data.draw(st.text(alphabet='{}[]",:0123456789.-eENaIfity xyzSRF', max_size=8))
+    try:
+        root = model.parse(text[:at] + junk + text[at + cut :])
+    except BgrError as e:
+        assert e.message
+    else:
+        assert model.check(root) == []
+
+
 # ---- 9. output files ----------------------------------------------------------------------
 
 
