@@ -336,7 +336,7 @@ def build_parser() -> argparse.ArgumentParser:
         "resize it to --size one axis at a time, R boxes replicated or deleted, S boxes "
         "scaled, F boxes kept, alignments kept where they can be. Writes the retargeted boxes "
         "(.json, itself a valid input) or a model with each box's mesh fitted (.glb .gltf .obj "
-        ".ply .stl; a cube for a leaf without one).",
+        ".ply .stl .city.json; a cube for a leaf without one).",
     )
     retarget.add_argument("input", metavar="BOXES.json", help="the box hierarchy")
     retarget.add_argument(
@@ -351,6 +351,21 @@ def build_parser() -> argparse.ArgumentParser:
     )
     retarget.add_argument(
         "-o", "--output", metavar="OUT", help="OUT.json or a model file (default: JSON on stdout)"
+    )
+    retarget.add_argument(
+        "--max-boxes",
+        type=_whole,
+        default=200_000,
+        metavar="N",
+        help="refuse a result of more than N boxes (default 200000: about 1 GB and 10 s)",
+    )
+    retarget.add_argument(
+        "--allow-path",
+        action="append",
+        default=[],
+        metavar="DIR",
+        help="also let box meshes be read from under DIR (repeatable); by default they must "
+        "stay in the boxes file's folder",
     )
 
     fmt = commands.add_parser(

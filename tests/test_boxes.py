@@ -579,6 +579,72 @@ def test_fixed_columns_side_by_side_need_only_the_taller():
         assert assert_fixed_kept(root, result) == 2
 
 
+def test_empty_space_between_children_scales_like_an_s_box():
+    # a (F, 1-3), b (R, 4-6), c (S, 7-9) with gaps between them and the parent's ends, to 20:
+    # one sequence a, b, c with the gaps as S units; the R box takes the change first and is
+    # repeated at its own size (5 copies), its copies numbered from 1
+    kids = [
+        box("a", (1, 1, 0), (3, 4, 2), "FFS"),
+        box("b", (4, 1, 0), (6, 4, 2), "RSS"),
+        box("c", (7, 0, 0), (9, 5, 2)),
+    ]
+    root = parse(box("g", (0, 0, 0), (10, 5, 2), "SSS", kids))
+    result = retarget(root, (20, 5, 2), "x")
+    assert_valid(result, (20, 5, 2))
+    assert layout(result) == [
+        ("a", 1, 3),
+        ("b", 4, 6),
+        *[(f"b~{k}", 4 + 2 * k, 6 + 2 * k) for k in range(1, 6)],
+        ("c", 17, 19),
+    ]
+
+
+def test_a_fitted_node_gives_the_placement_back_when_it_was_valid(monkeypatch):
+    # force the fitting on every node: the placement's copies are undone, and the fitting of a
+    # valid tessellation is that tessellation (no gap, no move), with the copies numbered anew
+    # from 1 (the undone ones leave no holes)
+    from bgr.inverse.boxes import retarget as retargeting
+
+    root = model.read(EXAMPLES / "regular_facade.json")
+    size = (30, 20, 0.5)
+    plain = retarget(root, size)
+    monkeypatch.setattr(retargeting, "valid", lambda layout, placed: False)
+    forced = retarget(root, size)
+    assert_valid(forced, size)
+    assert np.allclose(parts(forced), parts(plain), atol=1e-6)
+    assert sorted(b.id for b in forced.walk()) == sorted(b.id for b in plain.walk())
+
+
+def test_too_many_boxes_are_refused_quickly(tmp_path, capsys):
+    content = text(
+        box(
+            "r",
+            (0, 0, 0),
+            (1, 1, 1),
+            "SSS",
+            [box("a", (0, 0, 0), (0.001, 1, 1), "RSS"), box("b", (0.001, 0, 0), (1, 1, 1))],
+        )
+    )
+    code, err, out = retarget_cli(tmp_path, capsys, content, "--size", "1000,1,1")
+    assert code == 1 and "more than 200,000 boxes" in err and "--max-boxes" in err
+    assert not out.exists()
+    code, err, out = retarget_cli(
+        tmp_path, capsys, content, "--size", "10,1,1", "--max-boxes", "20000"
+    )
+    assert code == 0 and len(list(model.read(out).walk())) == 9_003
+
+
+def test_ids_with_a_tilde_count_their_alignments():
+    # the input may use "~" in its ids: its boxes are not taken for copies
+    kids = [box("w~1", (0, 0, 0), (2, 4, 1)), box("door~a", (2, 0, 0), (4, 4, 1), "FSS")]
+    plain = [box("w", (0, 0, 0), (2, 4, 1)), box("door", (2, 0, 0), (4, 4, 1), "FSS")]
+    tilde = parse(box("root", (0, 0, 0), (4, 4, 1), "SSS", kids))
+    root = parse(box("root", (0, 0, 0), (4, 4, 1), "SSS", plain))
+    size = (6, 5, 1)
+    assert alignments(tilde, retarget(tilde, size)) == alignments(root, retarget(root, size))
+    assert alignments(root, retarget(root, size))[0] > 0
+
+
 # ---- 6. the order of the axes -------------------------------------------------------------
 
 
@@ -631,6 +697,12 @@ def test_inferred_grammar_gives_the_input_back(inferred, name):
     assert np.allclose(want, got, atol=1e-6)
 
 
+def test_the_grammar_says_the_least_size_its_fixed_boxes_need(inferred):
+    # building.json: the porch (fixed) and the wall around it need 4 x 4 x 2 m
+    header = inferred["building"].read_text().splitlines()[:8]
+    assert any("need at least 4 x 4 x 2 m" in line for line in header)
+
+
 def test_infer_matches_the_shipped_grammars(inferred):
     for name in ("regular_facade", "building"):
         shipped = (EXAMPLES / f"{name}.bgr").read_text().splitlines()
@@ -652,6 +724,10 @@ def test_inferred_grammar_replicates_as_retarget_does(inferred, name, factors):
 # ---- 8. bad input -------------------------------------------------------------------------
 
 BAD = {
+    "a key beside root": (
+        '{"root": {"id": "r", "min": [0, 0, 0], "max": [1, 1, 1]}, "extra": 1}',
+        ["'extra'", "root"],
+    ),  # fmt: skip
     "overlap": (
         text(
             box(
@@ -755,6 +831,7 @@ def test_nan_is_refused(tmp_path, capsys):
     [
         ["--size", "3,4"],
         ["--size", "a,b,c"],
+        ["--size", "1_0,4,1"],
         ["--size", "0,4,1"],
         ["--size", "5,4,1", "--order", "xx"],
         ["--size", "5,4,1", "--order", "xw"],
@@ -850,6 +927,30 @@ def test_json_output_reads_back_and_retargets_again(tmp_path, capsys):
     second = model.read(again)
     assert_valid(second, (12, 9, 0.5))
     assert assert_fixed_kept(first, second) > 0
+
+
+def test_a_mesh_outside_the_boxes_folder_needs_allow_path(tmp_path, capsys):
+    outside = tmp_path / "parts"
+    outside.mkdir()
+    shutil.copy(EXAMPLES / "parts" / "door.obj", outside / "door.obj")
+    here = tmp_path / "boxes"
+    here.mkdir()
+    doc = box("root", (0, 0, 0), (4, 4, 1))
+    doc["mesh"] = "../parts/door.obj"
+    (here / "b.json").write_text(text(doc))
+    out = here / "b.obj"
+    assert main(["retarget", str(here / "b.json"), "--size", "5,4,1", "-o", str(out)]) == 1
+    err = capsys.readouterr().err
+    assert "outside the boxes file's folder" in err and "--allow-path" in err
+    assert not out.exists()
+    args = ["retarget", str(here / "b.json"), "--size", "5,4,1", "-o", str(out)]
+    assert main([*args, "--allow-path", str(outside)]) == 0 and out.exists()
+
+
+def test_a_byte_order_mark_is_read(tmp_path):
+    path = tmp_path / "bom.json"
+    path.write_bytes(b"\xef\xbb\xbf" + text(box("r", (0, 0, 0), (1, 1, 1))).encode())
+    assert model.read(path).id == "r"
 
 
 def test_glb_output_passes_the_khronos_validator(tmp_path, capsys, validator):

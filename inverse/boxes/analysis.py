@@ -4,8 +4,9 @@
   within epsilon; a cluster of two or more faces whose total area exceeds the average cluster's
   is a group.  Boxes higher up inherit the index where their faces coincide with the group's.
 * **Compatibility graph** of each node's children: an edge from box a to box b when a face of a
-  touches b across the axis (b above a, their cross-sections overlapping), or when a and b share
-  a whole face beside each other and have the same behaviour along the axis.
+  touches b across the axis (b above a, their cross-sections overlapping; or b next above a
+  across empty space), or when a and b share a whole face beside each other and have the same
+  behaviour along the axis.
 * **Sequences**: the primary is the longest path (in boxes) from the child at the node's
   bottom-front-left corner to the top, never moving down, left or back; the secondaries are
   longest paths of what remains, from the lowest to the highest boxes of its components, each
@@ -161,7 +162,11 @@ def analyse_node(box: Box, axis: int) -> NodeAnalysis:
         side |= coincide
     same_tag = np.array(tags)[:, None] == np.array(tags)[None, :]
     side &= same_tag
-    edge = up | side
+    under = _below(lo, hi, axis)
+    # boxes with empty space between them (children need not fill their parent) follow each
+    # other too when nothing lies between: the space scales like an S box in their sequence
+    step = up | (under & ~((under.astype(np.float32) @ under.astype(np.float32)) > 0))
+    edge = step | side
     # a topological order: every edge goes up, or sideways towards larger coordinates
     order = sorted(
         range(n),
@@ -198,14 +203,14 @@ def analyse_node(box: Box, axis: int) -> NodeAnalysis:
         used[path] = True
         units = _units(path, lo[:, axis], hi[:, axis], tags)
         first, last = path[0], path[-1]
-        below = [int(j) for j in np.nonzero(up[:, first] & used)[0] if j not in path]
-        above = [int(j) for j in np.nonzero(up[last, :] & used)[0] if j not in path]
+        below = [int(j) for j in np.nonzero(step[:, first] & used)[0] if j not in path]
+        above = [int(j) for j in np.nonzero(step[last, :] & used)[0] if j not in path]
         if lo[first, axis] <= bottom + EPS:
             below = []
         if hi[last, axis] >= top - EPS:
             above = []
         sequences.append(Sequence(units, below, above, primary=not sequences))
-    return NodeAnalysis(edges, sequences, up, _below(lo, hi, axis))
+    return NodeAnalysis(edges, sequences, up, under)
 
 
 def _lowest_and_highest(free, edge, lo, hi) -> tuple[list[int], list[int]]:

@@ -12,7 +12,9 @@ import numpy as np
 from bgr.formats.atomic import write_text as write_atomic
 from bgr.grammar.errors import BgrError
 from bgr.grammar.formatter import format_module
+from bgr.grammar.paths import check_input, roots_of, within
 
+from .analysis import min_length
 from .emit import ATTRS, write
 from .model import AXES, Box, dumps, read
 from .retarget import alignments, check_order, retarget
@@ -25,7 +27,7 @@ CHECK_SCALES = (0.6, 1.5, 2.5)
 def parse_size(text: str) -> tuple[float, float, float]:
     parts = [p.strip() for p in text.split(",")]
     try:
-        values = [float(p) for p in parts]
+        values = [float(p) for p in parts if "_" not in p]
     except ValueError:
         values = []
     if len(values) != 3 or not all(0 < v < 1e6 for v in values):
@@ -43,7 +45,7 @@ def run_retarget(args) -> int:
     out = None if args.output in (None, "-") else Path(args.output)
     source = Path(args.input)
     root = read(source)
-    result = retarget(root, size, args.order)
+    result = retarget(root, size, args.order, max_boxes=args.max_boxes)
     kept, total = alignments(root, result)
     if out is None or out.name.lower().endswith(".json") and not _mesh_json(out):
         text = dumps(result)
@@ -52,7 +54,7 @@ def run_retarget(args) -> int:
         else:
             write_atomic(out, text)
     else:
-        save_mesh(result, source.parent, out)
+        save_mesh(result, roots_of(source.parent, args.allow_path), source.parent, out)
     boxes = sum(1 for _ in result.walk())
     print(
         f"{args.output or '<stdout>'}: {boxes} boxes ({sum(1 for _ in root.walk())} in the input), "
@@ -70,7 +72,7 @@ def _size(box: Box) -> str:
     return " x ".join(f"{v:g}" for v in box.size) + " m"
 
 
-def save_mesh(result: Box, base: Path, out: Path) -> None:
+def save_mesh(result: Box, roots: tuple[Path, ...], base: Path, out: Path) -> None:
     """Each box with a mesh gets its part fitted; each leaf without one, a cube (labelled with
     the box's source id), written by extension like bgr derive's outputs."""
     from bgr.formats import write as write_table
@@ -85,7 +87,7 @@ def save_mesh(result: Box, base: Path, out: Path) -> None:
             continue
         if box.mesh:
             if box.mesh not in parts:
-                parts[box.mesh] = table.library.add(_load_part(base, box.mesh))
+                parts[box.mesh] = table.library.add(_load_part(roots, base, box.mesh))
             mesh = parts[box.mesh]
         else:
             mesh = cube
@@ -102,12 +104,19 @@ def save_mesh(result: Box, base: Path, out: Path) -> None:
     write_table(table, out, seed=0, attrs={})
 
 
-def _load_part(base: Path, mesh: str):
+def _load_part(roots: tuple[Path, ...], base: Path, mesh: str):
+    """A box's part, read only from under ``roots`` (as a grammar's assets are)."""
     import trimesh
 
     from bgr.interpreter.terminals import UnitMesh
 
     path = base / mesh
+    if not within(path, roots):
+        raise BgrError(
+            f"mesh '{mesh}' is outside the boxes file's folder ({base}); "
+            "let bgr read it with --allow-path DIR"
+        )
+    check_input(path, "mesh")
     if not path.is_file():
         raise BgrError(f"mesh '{mesh}' not found (looked for {path})")
     try:
@@ -166,10 +175,15 @@ def run_infer(args) -> int:
 
 
 def compare(root: Box, where: Path, base: Path) -> str:
-    """How the grammar does against bgr retarget at CHECK_SCALES of the input's size: the
-    sizes where it gives the same boxes, and the alignments each keeps."""
+    """How the grammar does against bgr retarget at CHECK_SCALES of the input's size (raised
+    to what the fixed boxes need): the sizes where it gives the same boxes, and the alignments
+    each keeps."""
+    least = [min_length(root, a) for a in range(3)]
     sizes = [
-        tuple(v * scale if t != "F" else v for v, t in zip(root.size, root.tags, strict=True))
+        tuple(
+            v if t == "F" else max(v * scale, need)
+            for v, t, need in zip(root.size, root.tags, least, strict=True)
+        )
         for scale in CHECK_SCALES
     ]
     named = write(root, "", base, where.parent, labels=True)

@@ -27,6 +27,7 @@ from pathlib import Path
 from bgr.grammar import nodes as n
 from bgr.grammar.registry import BUILTIN_NAMES, KEYWORDS, OPERATIONS
 
+from .analysis import min_length
 from .model import AXES, EPS, Box
 
 ATTRS = ("width", "height", "length")  # x, y, z ('depth' is the derivation depth in .bgr)
@@ -310,12 +311,16 @@ class _Writer:
             ),
         )
         boxes = sum(1 for _ in root.walk())
+        least = " x ".join(f"{min_length(root, a):g}" for a in range(3))
         header = [
             f"# Inferred by bgr infer --kind boxes from {self.source or 'a box hierarchy'}: "
-            f"{boxes} boxes, {len(self.rules)} rules.",
+            f"{boxes} boxes, {len(self.rules) + 1} rules.",
             "# Derive it at another size with --set width=W --set height=H --set length=L (x, y, z",
             "# in metres; y is up). R boxes replicate as bgr retarget replicates them, S boxes",
-            "# scale, F boxes keep their size.",
+            "# scale, F boxes keep their size"
+            + (" (except where an approximation below resizes them)." if self.notes else "."),
+            f"# The fixed boxes need at least {least} m: bgr retarget refuses a smaller size,",
+            "# this grammar squeezes them.",
         ]
         if self.notes:
             header.append("# Approximated (bgr retarget does better here):")

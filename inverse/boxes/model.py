@@ -18,6 +18,7 @@ from pathlib import Path
 import numpy as np
 
 from bgr.grammar.errors import BgrError
+from bgr.grammar.paths import read_input
 
 AXES = "xyz"
 BEHAVIOURS = ("S", "R", "F")
@@ -99,7 +100,7 @@ def read(path: str | Path) -> Box:
     """The hierarchy in a boxes JSON file, checked (:func:`parse`)."""
     path = Path(path)
     try:
-        text = path.read_bytes().decode("utf-8")
+        text = read_input(path, "boxes file").decode("utf-8-sig")  # a byte-order mark is fine
     except FileNotFoundError:
         raise BgrError(f"{path}: no such file") from None
     except IsADirectoryError:
@@ -126,6 +127,12 @@ def parse(text: str, name: str = "<boxes>") -> Box:
         raise BgrError(
             f'{name}: a boxes file is an object with a "root" box: '
             '{"root": {"id": ..., "min": [x, y, z], "max": [x, y, z], "children": [...]}}'
+        )
+    extra = sorted(set(doc) - {"root"})
+    if extra:
+        raise BgrError(
+            f'{name}: unknown key(s) {", ".join(map(repr, extra))} beside "root"; a boxes file '
+            'holds only {"root": ...}'
         )
     ids: dict[str, str] = {}
     root = _box(doc["root"], name, "root", ids, fixed=(False, False, False))
@@ -183,7 +190,9 @@ def _box(obj, name: str, where: str, ids: dict, fixed: tuple[bool, bool, bool]) 
         ):
             raise BgrError(f'{name}: {here}: "{key}" must be three numbers [x, y, z]')
         if not all(math.isfinite(c) and abs(c) < 1e9 for c in v):
-            raise BgrError(f'{name}: {here}: "{key}" holds a number that is not finite')
+            raise BgrError(
+                f'{name}: {here}: "{key}" holds a number that is not finite or is beyond 1e9 m'
+            )
         corners.append(np.array(v, dtype=np.float64))
     lo, hi = corners
     if np.any(hi - lo <= EPS):

@@ -35,17 +35,19 @@ from .analysis import Analysis, Sequence, Unit, analyse, min_length
 from .model import AXES, EPS, Box
 from .repair import Layout, Placed, fit, fits, valid
 
+MAX_BOXES = 200_000  # a retargeting making more is refused: a size asked by mistake (~1 GB)
 NUDGE = 1e-9  # floor(x + NUDGE): 2.9999999999 repeats are 3 (the grammar writes the same)
 
 
-def retarget(root: Box, size: Seq[float], order: str = "xyz") -> Box:
+def retarget(root: Box, size: Seq[float], order: str = "xyz", max_boxes: int = MAX_BOXES) -> Box:
     """A retargeted copy of ``root`` whose size is ``size`` (x, y, z), one axis at a time in
-    ``order`` (any arrangement of "xyz"; axes left out keep their size)."""
+    ``order`` (any arrangement of "xyz"; axes left out keep their size); a BgrError if the
+    result would have more than ``max_boxes`` boxes."""
     check_order(order)
     out = root.copy()
     for name in order:
         axis = AXES.index(name)
-        out = retarget_axis(out, axis, float(size[axis]))
+        out = retarget_axis(out, axis, float(size[axis]), max_boxes=max_boxes)
     return out
 
 
@@ -54,7 +56,13 @@ def check_order(order: str) -> None:
         raise BgrError(f"--order {order!r}: write the axes to retarget in turn, such as xyz or yx")
 
 
-def retarget_axis(root: Box, axis: int, length: float, analysis: Analysis | None = None) -> Box:
+def retarget_axis(
+    root: Box,
+    axis: int,
+    length: float,
+    analysis: Analysis | None = None,
+    max_boxes: int = MAX_BOXES,
+) -> Box:
     """``root`` (changed in place and returned) resized to ``length`` along ``axis``."""
     name = AXES[axis]
     if not (math.isfinite(length) and length > 0):
@@ -72,14 +80,17 @@ def retarget_axis(root: Box, axis: int, length: float, analysis: Analysis | None
         raise BgrError(
             f"the fixed boxes along {name} need at least {shortest:g} m; {length:g} m is shorter"
         )
-    Retargeter(root, axis, analysis or analyse(root, axis)).resize(
+    Retargeter(root, axis, analysis or analyse(root, axis), max_boxes).resize(
         root, float(root.lo[axis]), float(root.lo[axis]) + length
     )
     return root
 
 
 class Retargeter:
-    def __init__(self, root: Box, axis: int, analysis: Analysis) -> None:
+    def __init__(
+        self, root: Box, axis: int, analysis: Analysis, max_boxes: int = MAX_BOXES
+    ) -> None:
+        self.max_boxes = max_boxes
         self.axis = axis
         self.analysis = analysis
         groups = sorted(analysis.groups.items(), key=lambda kv: kv[1][0])
@@ -87,7 +98,9 @@ class Retargeter:
         self.group_pos = [p for _, (p, _) in groups]
         self.aligned: dict[int, float] = {}  # alignment index -> where its first face went
         self.mins: dict = {}
-        self.taken = {b.id for b in root.walk()}  # ids in use: a copy gets a fresh one
+        self.taken = {b.id for b in root.walk()}  # the input's ids: a copy gets a fresh one
+        self.copied: dict[str, int] = {}  # source id -> the last copy number its ids used
+        self.boxes = len(self.taken)  # boxes in the result so far
 
     # ---- alignment ---------------------------------------------------------------------
     def group(self, position: float) -> int | None:
@@ -126,6 +139,7 @@ class Retargeter:
             ends,
         )
         saved = [(b, float(b.lo[a]), float(b.hi[a]), b.children) for b in box.walk()]
+        saved_counts = (dict(self.copied), self.boxes)
         box.lo[a], box.hi[a] = lo, hi
         placed: dict[int, Placed] = {}
         copies: dict[int, list[Box]] = {}
@@ -145,6 +159,7 @@ class Retargeter:
             # the placement left boxes overlapping or outside: undo it and fit (repair.py)
             for b, was_lo, was_hi, children in saved:
                 b.lo[a], b.hi[a], b.children = was_lo, was_hi, children
+            self.copied, self.boxes = dict(saved_counts[0]), saved_counts[1]
             box.lo[a], box.hi[a] = lo, hi
             for i, p in enumerate(slots):
                 if p.count == 0 and kids[i].tags[a] == "S":
@@ -168,6 +183,14 @@ class Retargeter:
             return
         step = (p.hi - p.lo) / p.count
         self.resize(kids[i], p.lo, p.lo + step)
+        size = sum(1 for _ in kids[i].walk())
+        self.boxes += size * (p.count - 1)
+        if self.boxes > self.max_boxes:
+            raise BgrError(
+                f"the result would have more than {self.max_boxes:,} boxes ('{kids[i].source}' "
+                f"repeated {p.count:,} times along {AXES[self.axis]}): ask a smaller size, or "
+                "raise --max-boxes"
+            )
         copies[i] = [self.replicate(kids[i], c * step, c) for c in range(1, p.count)]
 
     def replicate(self, box: Box, by: float, number: int) -> Box:
@@ -175,11 +198,11 @@ class Retargeter:
         out = box.copy()
         out.shift(self.axis, by)
         for b in out.walk():
-            k = 1
+            k = self.copied.get(b.source, 0) + 1
             while f"{b.source}~{k}" in self.taken:
                 k += 1
+            self.copied[b.source] = k
             b.id = f"{b.source}~{k}"
-            self.taken.add(b.id)
             b.replica = number
         return out
 
@@ -229,7 +252,14 @@ class Retargeter:
             end = min(placed[j].lo for j in seq.above)
         else:
             end_old, end = ends[1], new_ends[1]
-        # empty space between an anchor and the sequence scales like an S box
+        # empty space between an anchor and the sequence, or between two of its units, scales
+        # like an S box
+        spaced = [units[0]]
+        for unit in units[1:]:
+            if unit.lo - spaced[-1].hi > EPS:
+                spaced.append(Unit([], spaced[-1].hi, unit.lo, "S"))
+            spaced.append(unit)
+        units = spaced
         if units[0].lo - start_old > EPS:
             units.insert(0, Unit([], start_old, units[0].lo, "S"))
         if end_old - units[-1].hi > EPS:
@@ -400,9 +430,11 @@ def repeats(x: float) -> int:
 
 def alignments(source: Box, result: Box, axis: int | None = None) -> tuple[int, int]:
     """(kept, total): pairs of input leaves with a face in the same alignment group, whose
-    faces still line up in ``result`` (the leaves of the same ids, copies left aside)."""
+    faces still line up in ``result`` (the leaves of the same ids, copies left aside: a copy
+    has an id not in the input, or another replica number)."""
     axes = range(3) if axis is None else [axis]
-    placed = {b.id: b for b in result.leaves() if b.replica == 0 and "~" not in b.id}
+    replicas = {b.id: b.replica for b in source.walk()}
+    placed = {b.id: b for b in result.leaves() if replicas.get(b.id, -1) == b.replica}
     kept = total = 0
     for a in axes:
         groups = analyse_groups(source, a)
