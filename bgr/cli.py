@@ -462,7 +462,8 @@ def add_budget_options(command: argparse.ArgumentParser) -> None:
     command.add_argument(
         "--max-memory",
         metavar="SIZE",
-        help="memory ceiling, e.g. 4G or 512M (default: 80%% of the memory available at start)",
+        help="memory ceiling on what the run allocates, e.g. 4G or 512M (default: 80%% of the "
+        "memory available at start)",
     )
 
 

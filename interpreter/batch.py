@@ -36,13 +36,28 @@ from bgr.grammar.checker import Grammar
 from bgr.grammar.errors import BgrError, Diagnostic, Warnings
 
 from .engine import Engine
-from .limits import default_max_memory
+from .limits import default_max_memory, memory_in_use
 from .lots import Lot, attr_overrides
 from .terminals import TerminalTable
 
 # the split cache (pure: sizes -> placed pieces) is kept across the lots one process derives,
 # and emptied when it holds more entries than this, so that a long run does not grow with it
 CACHE_ENTRIES = 50_000
+
+# job token -> this process's resident memory when it began deriving that run's lots: the
+# memory ceiling budgets what a run allocates from there (every lot this process derives of
+# the run together), not what the process held before it
+_MEMORY_BASES: dict[str, int] = {}
+
+
+def memory_base(job: Job) -> int:
+    """Resident memory of this process when it derived its first lot of ``job``."""
+    base = _MEMORY_BASES.get(job.token)
+    if base is None:
+        if len(_MEMORY_BASES) >= 64:  # a worker that outlives many runs forgets old ones
+            _MEMORY_BASES.clear()
+        base = _MEMORY_BASES[job.token] = memory_in_use()
+    return base
 
 
 @dataclass
@@ -60,6 +75,7 @@ class Job:
     max_shapes: int = 3_500_000
     max_triangles: int = 20_000_000
     max_memory: int | None = None  # None: 80 % of the memory available to the process deriving
+    # (the ceiling is on what the run allocates in that process, from its first lot: memory_base)
     # the shape and triangle budgets hold for each lot on its own (a run whose lots are written
     # as they come and dropped), not for all lots together (a run that keeps them all)
     per_lot: bool = False
@@ -113,6 +129,7 @@ def derive_lot(
             lot_name=name,
             max_triangles=job.max_triangles,
             max_memory=max_memory,
+            memory_base=memory_base(job),
         )
         table = engine.table
         if cache is not None:

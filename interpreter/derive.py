@@ -83,8 +83,9 @@ def derive(
 
     The budgets hold for the whole run, all lots together: ``max_depth`` nested rules,
     ``max_shapes`` shapes, ``max_triangles`` triangles of terminals, and ``max_memory`` bytes
-    held by the process (None: 80 % of the memory the machine has available when the run
-    starts).  Passing one of them raises a located :class:`bgr.BgrError`; see docs/limits.md.
+    allocated by the run from its start, whatever the process held before (None: 80 % of the
+    memory the machine has available when the run starts).  Passing one of them raises a
+    located :class:`bgr.BgrError`; see docs/limits.md.
 
     ``allow_paths`` is passed to :func:`bgr.load` when ``grammar`` is not loaded yet.
     ``lot_options`` (:class:`~bgr.interpreter.lots.LotOptions`: the front edge, ``--map``) apply

@@ -83,6 +83,7 @@ class Engine:
         lot_name: str = "",
         max_triangles: int = DEFAULT_MAX_TRIANGLES,
         max_memory: int | None = None,
+        memory_base: int | None = None,
     ) -> None:
         self.grammar, self.seed, self.lot_index = grammar, seed, lot_index
         self.warnings = warnings if warnings is not None else Warnings()
@@ -90,10 +91,16 @@ class Engine:
         self.max_depth, self.max_shapes = max_depth, max_shapes
         self.max_triangles, self.max_memory = max_triangles, max_memory
         self.triangles = 0
+        # the ceiling budgets what the run allocates, not what the process held before it (a
+        # notebook's arrays, a test session): growth is measured from the run's resident memory
+        # at its start, ``memory_base`` (this engine's start when not given)
+        self.memory_base = 0
         # the shape count at which memory is expected to reach the ceiling (see check_memory)
         self.memory_full_at: float = math.inf
         if max_memory is not None:
-            self.memory_full_at = (max_memory - memory_in_use()) / BYTES_PER_SHAPE
+            now = memory_in_use()
+            self.memory_base = now if memory_base is None else memory_base
+            self.memory_full_at = (max_memory - (now - self.memory_base)) / BYTES_PER_SHAPE
         self._mesh_triangles: list[int] = []  # triangles per library mesh id
         self.compilers: dict[int, Compiler] = {}
         self.attrs = self._prepare_values(grammar, dict(attrs or {}))
@@ -231,8 +238,9 @@ class Engine:
             self.check_memory(module, pos)
 
     def check_memory(self, module, pos) -> None:
-        """A located error once the process holds more than the memory ceiling."""
-        used = memory_in_use()
+        """A located error once the run has allocated more than the memory ceiling since it
+        started (the process's resident memory less ``memory_base``)."""
+        used = memory_in_use() - self.memory_base
         self.memory_full_at = self.shapes + (self.max_memory - used) / BYTES_PER_SHAPE
         if used > self.max_memory:
             raise runtime_error(
