@@ -34,9 +34,9 @@ EXAMPLE_SIZE = (640, 480)
 EXAMPLES = [
     ("house.bgr", None, 3, "iso"),
     ("tower.bgr", None, 1, "iso"),
-    ("l_building.bgr", "l_lot.geojson", 1, "iso"),
+    ("l_building.bgr", "l_lot.geojson", 1, (35.0, 30.0)),  # from behind: the L's inner corner
     ("city_block.bgr", None, 2, "iso"),
-    ("stdlib_street.bgr", "block.geojson", 5, (215.0, 30.0)),  # GeoJSON lots face south (+z)
+    ("stdlib_street.bgr", "block.geojson", 5, "iso"),
 ]
 
 # How a thumbnail shows each module's rules: a wrapper rule applying lib.NAME, and the view.

@@ -57,13 +57,21 @@ __all__ = [
 def make_camera(
     view: str | os.PathLike | Camera, scene: Scene, size: tuple[int, int] | None = None
 ) -> Camera:
-    """The camera for ``view``: a preset name (fitted to the scene), a Camera, or a camera .json
-    path.  ``size`` replaces the camera's image size when given."""
+    """The camera for ``view``: a preset name (fitted to the scene's triangles and turned to the
+    way its lots face, ``scene.front``), a Camera, or a camera .json path.  ``size`` replaces
+    the camera's image size when given."""
     if isinstance(view, Camera):
         return view if size is None else view.with_size(size)
     if isinstance(view, str) and view in PRESETS:
         lo, hi = scene.bounds()
-        return Camera.preset(view, lo, hi, size or DEFAULT_SIZE)
+        return Camera.preset(
+            view,
+            lo,
+            hi,
+            size or DEFAULT_SIZE,
+            front=scene.front,
+            points=scene.triangles.reshape(-1, 3) if len(scene) else None,
+        )
     if isinstance(view, (str, os.PathLike)) and str(view).lower().endswith(".json"):
         return Camera.from_json(view, size)
     raise BgrError(

@@ -71,7 +71,10 @@ def face_ids(scene: Scene, normal_tol: float = 1e-3, offset_tol: float = 1e-3) -
     if len(scene) == 0:
         return np.zeros(0, dtype=np.int64)
     n = scene.normals()
-    offset = np.einsum("ij,ij->i", n, scene.triangles[:, 0])
+    # each plane's offset from the model's centre, not the origin: at projected coordinates
+    # (10^6 m) the normals' rounding times the distance would split one wall into many planes
+    lo, hi = scene.bounds()
+    offset = np.einsum("ij,ij->i", n, scene.triangles[:, 0] - (lo + hi) / 2.0)
     rgb = scene.colors.astype(np.int64)
     look = scene.label * (1 << 24) + (rgb[:, 0] << 16) + (rgb[:, 1] << 8) + rgb[:, 2]
     key = np.column_stack([look, np.rint(n / normal_tol), np.rint(offset / offset_tol)]).astype(

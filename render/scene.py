@@ -18,6 +18,7 @@ triangles came from.
 
 from __future__ import annotations
 
+import math
 import os
 from collections.abc import Iterable
 from dataclasses import dataclass, field
@@ -42,6 +43,9 @@ class Scene:
     labels: list[str]
     # a derived grammar's warnings (footprints skipped or repaired, ...): bgr.Result.warnings
     warnings: list = field(default_factory=list)
+    # the direction the lots' fronts face (a unit world vector in the x-z plane, see
+    # lots_front), which the front/iso/top views look at; None: bgr's default front, -z
+    front: np.ndarray | None = None
 
     def __len__(self) -> int:
         return len(self.triangles)
@@ -61,6 +65,42 @@ class Scene:
         bad = ~(length > 0)
         n[bad], length[bad] = (0.0, 1.0, 0.0), 1.0
         return n / length[:, None]
+
+
+def lots_front(lots: list) -> np.ndarray | None:
+    """The way a derivation's lots face, for the views: each lot's front faces against its
+    scope's z (its front edge's outward normal), weighted by the front edge's length (the
+    scope's x size).  The result is the weighted mean over the lots facing within 90 degrees of
+    the direction the most front length faces (a sum of ``w max(0, cos)`` over whole degrees), so
+    that the two sides of a street, facing each other, do not cancel out; None without lots."""
+    normals, weights = [], []
+    for lot in lots:
+        try:
+            z = np.asarray(lot["axes"], dtype=np.float64).reshape(3, 3)[2]
+            width = float(np.asarray(lot.get("size", (1.0,)), dtype=np.float64).reshape(-1)[0])
+        except (AttributeError, KeyError, TypeError, ValueError):
+            continue
+        n = np.array([-z[0], -z[2]])
+        length = float(np.hypot(*n))
+        if not (np.isfinite(n).all() and length > 1e-9):
+            continue
+        normals.append(n / length)
+        weights.append(width if math.isfinite(width) and width > 0 else 1.0)
+    if not normals:
+        return None
+    n, w = np.array(normals), np.array(weights)
+    # the weights in 360 one-degree bins, then the best of 360 directions by sum w max(0, cos)
+    bins = np.rint(np.degrees(np.arctan2(n[:, 1], n[:, 0]))).astype(np.int64) % 360
+    mass = np.bincount(bins, weights=w, minlength=360)
+    angle = np.radians(np.arange(360))
+    score = np.maximum(np.cos(angle[:, None] - angle[None, :]), 0.0) @ mass
+    best = angle[int(np.argmax(score))]
+    side = n @ np.array([math.cos(best), math.sin(best)]) > 1e-9
+    mean = (w[side, None] * n[side]).sum(axis=0)
+    length = float(np.linalg.norm(mean))
+    if not length > 1e-9:  # cannot happen with lots in that half-plane; be safe
+        return None
+    return np.array([mean[0] / length, 0.0, mean[1] / length])
 
 
 def _labels_index(names) -> tuple[np.ndarray, list[str]]:
@@ -86,6 +126,7 @@ def from_result(result: Any) -> Scene:
         label=label_of_row[row],
         labels=labels,
         warnings=list(getattr(result, "warnings", [])),
+        front=lots_front(table.lots),
     )
 
 

@@ -19,6 +19,7 @@ from bgr.render import (
     Camera,
     images,
     load_scene,
+    make_camera,
     raster_gl,
     raster_numpy,
     rasterise,
@@ -373,7 +374,7 @@ def test_labels_give_one_colour_per_label(house):
     )
     colours = list(legend["labels"].values())
     assert len(set(colours)) == len(colours) and "#000000" not in colours
-    frame = rasterise(house, Camera.preset("iso", *house.bounds(), size=(320, 240)), "numpy")
+    frame = rasterise(house, make_camera("iso", house, (320, 240)), "numpy")  # render's camera
     label_at = np.array(house.labels + ["(background)"])[
         np.concatenate([house.label, [-1]])[frame.triangle]
     ]
