@@ -17,8 +17,9 @@ and best of ``--repeat`` runs in this process:
 
 ``--validity N`` instead retargets N random façades (seeds 1..N: 3 to 8 storeys, each axis to
 60 %, 80 %, 150 % or 250 %, order xy or yx) and counts the results that are valid hierarchies of
-the size asked, the sizes refused (shorter than the fixed boxes need), and the nodes whose
-placement had to be fitted (inverse/boxes/repair.py).
+the size asked, the sizes refused (shorter than the fixed boxes need), the results with a hole
+(empty space in a box whose children filled it in the input), and the nodes whose placement had
+to be fitted (inverse/boxes/repair.py).
 """
 
 from __future__ import annotations
@@ -35,7 +36,7 @@ import numpy as np
 from bgr.grammar.errors import BgrError
 from bgr.inverse.boxes import retarget as retargeting
 from bgr.inverse.boxes.analysis import analyse
-from bgr.inverse.boxes.model import check, parse
+from bgr.inverse.boxes.model import check, holes, parse
 from bgr.inverse.boxes.retarget import retarget, retarget_axis
 
 
@@ -99,7 +100,7 @@ def validity(n: int) -> None:
         return fit(*args)
 
     retargeting.fit = counting
-    valid = invalid = refused = 0
+    valid = invalid = refused = holed = 0
     for seed in range(1, n + 1):
         rng = random.Random(seed)
         root = parse(json.dumps(facade(rng.randint(3, 8), seed)))
@@ -114,9 +115,10 @@ def validity(n: int) -> None:
             invalid += 1
         else:
             valid += 1
+        holed += bool(holes(root, result))
     retargeting.fit = fit
     print(f"{n} random façades: {valid} valid, {invalid} invalid, {refused} refused (too short);")
-    print(f"{fitted} node placements fitted")
+    print(f"{holed} with a hole in a wall the input closed; {fitted} node placements fitted")
 
 
 def main() -> None:

@@ -3,7 +3,8 @@
     python docs/make_gallery.py     # everything: examples, thumbnails, contact sheet, stdlib.md
     python docs/make_gallery.py --only examples
 
-Writes docs/img/examples/*.png (the examples, as the README shows them), one thumbnail per public
+Writes docs/img/examples/*.png (the examples, as the README shows them, and retarget.png: the
+regular façade through bgr retarget), one thumbnail per public
 stdlib rule in docs/img/stdlib/<module>/<Rule>.png, a contact sheet of them all
 (docs/img/stdlib/contact_sheet.png) and docs/stdlib.md.  Deterministic: the same code gives the
 same pictures.  PNGs are palette-quantised to keep the repository small.
@@ -114,6 +115,23 @@ def captured() -> None:
     print("  examples/captured/before_after.png", file=sys.stderr)
 
 
+def retargeted() -> None:
+    """examples/boxes/regular_facade.json retargeted to 30 x 20 m, as README's command writes it
+    (``bgr retarget ... -o facade.glb``), from the iso view."""
+    import tempfile
+
+    from bgr.cli import main as bgr_main
+
+    with tempfile.TemporaryDirectory() as tmp:
+        out = Path(tmp) / "facade.glb"
+        source = ROOT / "examples" / "boxes" / "regular_facade.json"
+        if bgr_main(["retarget", str(source), "--size", "30,20,0.5", "-o", str(out)]) != 0:
+            raise SystemExit("bgr retarget failed")
+        image = render(load_scene(out), "shaded", "iso", EXAMPLE_SIZE)
+    save(image, DOCS / "img" / "examples" / "retarget.png")
+    print("  examples/boxes/regular_facade.json retargeted: retarget.png", file=sys.stderr)
+
+
 def thumbnail(module: str, rule: str) -> np.ndarray:
     template, view = WRAPPERS[module]
     if module == "window" and rule.endswith("Entrance"):
@@ -165,6 +183,7 @@ def main(argv: list[str] | None = None) -> int:
     if args.only in (None, "examples"):
         examples()
         captured()
+        retargeted()
     if args.only in (None, "stdlib"):
         made = thumbnails()
         contact_sheet(made)

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 import re
 import sys
 from pathlib import Path
@@ -16,7 +17,7 @@ from bgr.grammar.paths import check_input, roots_of, within
 
 from .analysis import min_length
 from .emit import ATTRS, write
-from .model import AXES, Box, dumps, read
+from .model import AXES, EPS, Box, dumps, read
 from .retarget import alignments, check_order, retarget
 
 USAGE = 2
@@ -74,32 +75,36 @@ def _size(box: Box) -> str:
 
 def save_mesh(result: Box, roots: tuple[Path, ...], base: Path, out: Path) -> None:
     """Each box with a mesh gets its part fitted; each leaf without one, a cube (labelled with
-    the box's source id), written by extension like bgr derive's outputs."""
+    the box's source id), written by extension like bgr derive's outputs.  Colours tell the
+    parts apart (:func:`colour`); a part's recessed pieces (a window's pane, a door's leaf) get
+    the part's colour and the rest (its frame of wall) the wall's."""
     from bgr.formats import write as write_table
     from bgr.interpreter.geometry.meshes import primitive
     from bgr.interpreter.terminals import TerminalTable, UnitMesh
 
     table = TerminalTable()
-    parts: dict[str, int] = {}
-    cube = table.library.add(UnitMesh("cube", *primitive("cube")))
+    parts: dict[str, list[tuple[int, bool]]] = {}  # mesh -> (library id, infill) pieces
+    cube = [(table.library.add(UnitMesh("cube", *primitive("cube"))), True)]
     for box in result.walk():
         if box.children and not box.mesh:
             continue
         if box.mesh:
             if box.mesh not in parts:
-                parts[box.mesh] = table.library.add(_load_part(roots, base, box.mesh))
-            mesh = parts[box.mesh]
+                pieces = _pieces(_load_part(roots, base, box.mesh))
+                parts[box.mesh] = [(table.library.add(m), infill) for m, infill in pieces]
+            meshes = parts[box.mesh]
         else:
-            mesh = cube
-        table.label.append(box.source)
-        table.rule.append(box.source)
-        table.path.append(box.id)
-        table.origin.append(box.lo.tolist())
-        table.axes.append(np.eye(3).tolist())
-        table.size.append(box.size.tolist())
-        table.color.append(_colour(box))
-        table.material.append(None)
-        table.mesh.append(mesh)
+            meshes = cube
+        for mesh, infill in meshes:
+            table.label.append(box.source)
+            table.rule.append(box.source)
+            table.path.append(box.id)
+            table.origin.append(box.lo.tolist())
+            table.axes.append(np.eye(3).tolist())
+            table.size.append(box.size.tolist())
+            table.color.append(colour(box) if infill else shade(COLOURS["wall"], box))
+            table.material.append(None)
+            table.mesh.append(mesh)
     table.freeze()
     write_table(table, out, seed=0, attrs={})
 
@@ -132,24 +137,85 @@ def _load_part(roots: tuple[Path, ...], base: Path, mesh: str):
     return UnitMesh(Path(mesh).stem, unit, faces)
 
 
-PART_COLOURS = {  # parts named like these get a colour that reads as what they are
-    "window": (0.84, 0.78, 0.68),
-    "shop": (0.66, 0.72, 0.76),
-    "door": (0.36, 0.26, 0.20),
-    "porch": (0.70, 0.70, 0.68),
+def _pieces(part) -> list[tuple[Any, bool]]:
+    """A part as (mesh, infill) pieces: its connected pieces that touch neither the front nor
+    the back of its box (z 0 and 1: a pane, a door leaf, a shop window) are its infill, the
+    rest its frame.  A part with no such piece, or all of them, is one infill piece."""
+    import trimesh
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import connected_components
+
+    from bgr.interpreter.terminals import UnitMesh
+
+    faces, verts = part.faces, part.vertices
+    if len(faces) == 0:
+        return [(part, True)]
+    # pieces are faces joined by edges (pieces may share a corner vertex)
+    pairs = trimesh.Trimesh(verts, faces, process=False).face_adjacency
+    graph = coo_matrix(
+        (np.ones(len(pairs)), (pairs[:, 0], pairs[:, 1])), shape=(len(faces), len(faces))
+    )
+    _, piece = connected_components(graph, directed=False)
+    z = verts[faces][:, :, 2]
+    inner = [
+        k for k in np.unique(piece) if z[piece == k].min() > 1e-6 and z[piece == k].max() < 1 - 1e-6
+    ]
+    infill = np.isin(piece, inner)
+    if infill.all() or not infill.any():
+        return [(part, True)]
+    return [
+        (UnitMesh(f"{part.name}-{what}", verts, faces[keep]), keep is infill)
+        for what, keep in (("frame", ~infill), ("infill", infill))
+    ]
+
+
+# What a box is, by the words of its source id or its mesh's name (the first that matches), and
+# the colour each kind gets: glass, wood and stone apart from the wall at a glance.
+KINDS = (
+    ("door", ("door", "entrance", "entry", "lobby", "gate")),
+    ("shop", ("shop", "store", "vitrine")),
+    ("window", ("window", "wide", "narrow", "glass", "pane", "glazing")),
+    ("trim", ("sill", "lintel", "cornice", "ledge", "trim", "frame", "band", "parapet")),
+    ("porch", ("porch", "canopy", "balcony", "stair")),
+    ("roof", ("roof",)),
+)
+COLOURS = {
+    "wall": (0.80, 0.68, 0.55),  # warm render
+    "trim": (0.94, 0.92, 0.86),  # pale stone
+    "window": (0.27, 0.40, 0.54),  # blue glass
+    "shop": (0.44, 0.62, 0.68),  # shop glass, lighter and greener
+    "door": (0.40, 0.24, 0.14),  # wood
+    "porch": (0.58, 0.58, 0.56),  # concrete
+    "roof": (0.45, 0.30, 0.26),  # tiles
 }
 
 
-def _colour(box: Box) -> tuple[float, float, float]:
-    """A part's colour by its mesh's name, else a stable wall-like tone per source id."""
-    import zlib
+def kind(box: Box) -> str:
+    """The kind of part a box is (a key of COLOURS) by the last word of its mesh's name, else
+    of its source id, that names one; wall when none does."""
+    for text in (Path(box.mesh).stem if box.mesh else "", box.source):
+        # the last word that names a kind: ids go from the whole to the part (door-bay-cornice)
+        for word in reversed(re.sub(r"[-_~.\d]+", " ", text).lower().split()):
+            for name, keys in KINDS:
+                if any(k in word for k in keys):
+                    return name
+    return "wall"
 
-    if box.mesh:
-        for word, rgb in PART_COLOURS.items():
-            if word in Path(box.mesh).stem.lower():
-                return rgb
-    tones = [(0.80, 0.74, 0.64), (0.74, 0.60, 0.50), (0.70, 0.68, 0.62), (0.84, 0.80, 0.72)]
-    return tones[zlib.crc32(re.sub(r"[-_~]?\d+", "", box.source).encode()) % len(tones)]
+
+def colour(box: Box) -> tuple[float, float, float]:
+    """A box's colour: its kind's (:data:`COLOURS`), a shade lighter or darker by its place."""
+    return shade(COLOURS[kind(box)], box)
+
+
+def shade(rgb: tuple[float, float, float], box: Box) -> tuple[float, float, float]:
+    """``rgb`` a little lighter or darker in a checkerboard of the box's own size (its place
+    along each axis counted in its lengths), so that neighbours of a kind, a window and its
+    copy, a bay and the next, stay apart where they share a face."""
+    steps = sum(
+        math.floor(float(box.lo[a] / box.size[a]) + 1e-6) for a in range(3) if box.size[a] > EPS
+    )
+    k = 0.93 if steps % 2 else 1.0
+    return (rgb[0] * k, rgb[1] * k, rgb[2] * k)
 
 
 # ---- infer -------------------------------------------------------------------------------

@@ -254,3 +254,40 @@ def check(root: Box, eps: float = EPS) -> list[str]:
                 a, b = box.children[i], box.children[j]
                 problems.append(f"boxes '{a.id}' and '{b.id}' overlap")
     return problems
+
+
+def uncovered(box: Box, eps: float = EPS) -> float:
+    """The volume of ``box`` its children leave empty (0 for a leaf: its part fills it), exact:
+    the box is cut into cells at every child's faces and the cells no child holds are summed."""
+    kids = [c for c in box.children if np.all(c.size > eps)]
+    if not box.children:
+        return 0.0
+    cuts = [
+        np.unique(
+            np.round(
+                np.r_[box.lo[a], box.hi[a], [c.lo[a] for c in kids], [c.hi[a] for c in kids]], 9
+            )
+        )
+        for a in range(3)
+    ]
+    held = np.zeros([len(c) - 1 for c in cuts], dtype=bool)
+    for c in kids:
+        held[
+            tuple(
+                slice(*np.searchsorted(cuts[a], np.round([c.lo[a], c.hi[a]], 9))) for a in range(3)
+            )
+        ] = True
+    cells = np.einsum("i,j,k->ijk", *(np.diff(c) for c in cuts))
+    return float(cells[~held].sum())
+
+
+def holes(source: Box, result: Box, eps: float = EPS) -> list[str]:
+    """The boxes of ``result`` whose children leave empty space (more than ``eps`` of their
+    volume) though their source's children filled it: a wall the input closed, left open."""
+    volume = {b.id: float(np.prod(b.size)) for b in source.walk()}
+    closed = {b.id for b in source.walk() if b.children and uncovered(b) <= eps * volume[b.id]}
+    return [
+        b.id
+        for b in result.walk()
+        if b.source in closed and uncovered(b) > eps * max(float(np.prod(b.size)), eps)
+    ]

@@ -18,7 +18,10 @@ tessellation's neighbours must not come apart or overlap), then where its alignm
 put by the first face of the group placed (a soft constraint: kept only if no box gets a negative
 length, no fixed box must resize, and the rest of the sequence still fits), else where the
 distributed lengths put it.  A run of fixed units is skipped: the face below it moves so that the
-run's top lands aligned.
+run's top lands aligned.  Faces that stacks of fixed children hold at a node's ends are aligned
+first (:meth:`Retargeter.pin`), and an alignment may rescale a replicated unit only a little
+(``RHO``).  A node whose placement does not fit, or opens a gap the input did not have, is
+fitted (:mod:`.repair`).
 """
 
 from __future__ import annotations
@@ -33,7 +36,7 @@ from bgr.grammar.errors import BgrError
 
 from .analysis import Analysis, Sequence, Unit, analyse, min_length
 from .model import AXES, EPS, Box
-from .repair import Layout, Placed, fit, fits, valid
+from .repair import RHO, Layout, Placed, fit, fits, valid
 
 MAX_BOXES = 200_000  # a retargeting making more is refused: a size asked by mistake (~1 GB)
 NUDGE = 1e-9  # floor(x + NUDGE): 2.9999999999 repeats are 3 (the grammar writes the same)
@@ -144,6 +147,7 @@ class Retargeter:
         placed: dict[int, Placed] = {}
         copies: dict[int, list[Box]] = {}
         room = self.room(kids, node.touch, old_lo)
+        self.pin(kids, node.touch, old_lo, old_hi, ends, (lo, hi))
         fitting = True  # no child placed out of the node or below its minimum so far
         for seq in node.sequences:
             self.place(seq, kids, node.touch, old_lo, old_hi, ends, (lo, hi), placed, room)
@@ -205,6 +209,33 @@ class Retargeter:
             b.id = f"{b.source}~{k}"
             b.replica = number
         return out
+
+    def pin(self, kids: list[Box], touch, old_lo, old_hi, ends, new_ends) -> None:
+        """Align first the faces that stacks of fixed children hold at the node's ends (a door
+        on the ground holds its top at the door's height): a sequence placed earlier would
+        otherwise set their alignment where the fixed boxes cannot follow, and open a gap over
+        them (a deviation from the paper, which aligns to whichever face is placed first)."""
+        a = self.axis
+        fixed = [k.tags[a] == "F" for k in kids]
+        order = sorted(range(len(kids)), key=lambda i: old_lo[i])
+        up: dict[int, float] = {}  # a fixed child held from the bottom -> its new lo
+        for i in order:
+            under = [int(j) for j in np.nonzero(touch[:, i])[0] if int(j) in up]
+            if fixed[i] and (old_lo[i] <= ends[0] + EPS or under):
+                up[i] = (
+                    new_ends[0] if not under else up[under[0]] + old_hi[under[0]] - old_lo[under[0]]
+                )
+                self.mark(old_lo[i], up[i])
+                self.mark(old_hi[i], up[i] + old_hi[i] - old_lo[i])
+        down: dict[int, float] = {}  # a fixed child held from the top -> its new hi
+        for i in reversed(order):
+            over = [int(j) for j in np.nonzero(touch[i, :])[0] if int(j) in down]
+            if fixed[i] and (old_hi[i] >= ends[1] - EPS or over):
+                down[i] = (
+                    new_ends[1] if not over else down[over[0]] - (old_hi[over[0]] - old_lo[over[0]])
+                )
+                self.mark(old_hi[i], down[i])
+                self.mark(old_lo[i], down[i] - (old_hi[i] - old_lo[i]))
 
     def unit_min(self, unit: Unit, kids: list[Box]) -> float:
         """The shortest one copy of a unit can be made without deleting it."""
@@ -291,6 +322,9 @@ class Retargeter:
                     top = want
                 elif top < least - EPS or (top > most + EPS and most >= least):
                     top = max(pos, least if top < least else most)
+                    if unit.tag == "R" and top - pos < counts[k] * RHO * unit.length - EPS:
+                        # held short by its bounds: fewer copies rather than squeezed ones
+                        counts[k] = math.floor((top - pos) / (RHO * unit.length) + NUDGE)
                 if top != natural:
                     rest = cascade(units[k + 1 :], mins[k + 1 :], end - top)
                     counts[k + 1 :], lengths[k + 1 :] = rest
@@ -359,6 +393,11 @@ class Retargeter:
         length = want - pos
         if length < -EPS or length < (mins[k] * counts[k]) - EPS:
             return False
+        if units[k].tag == "R" and counts[k] and units[k].length > EPS:
+            # an alignment may rescale copies a little (the paper), not squeeze or stretch them
+            per = length / counts[k] / units[k].length
+            if not RHO - EPS <= per <= 1 / RHO + EPS:
+                return False
         rest = units[k + 1 :]
         room = end - want
         if all(u.tag == "F" for u in rest):
