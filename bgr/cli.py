@@ -738,6 +738,10 @@ def _progress(lots: int, output: str):
 
 
 def cmd_infer(args) -> int:
+    from .inverse.inputs import check_input
+
+    if args.kind in (None, "schema", "city", "boxes"):
+        check_input(args.input, args.kind)  # a photo or a binary file: say what is read
     kind = args.kind or _infer_kind(args.input)
     if kind == "city":
         from .inverse.city.command import run
