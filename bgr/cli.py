@@ -104,7 +104,7 @@ def build_parser() -> argparse.ArgumentParser:
     derive.add_argument(
         "--lot",
         metavar="W,D|LOTS.geojson",
-        help="the lot: width,depth in metres (default 20,20) or GeoJSON footprints",
+        help="the lot: W,D (or WxD) in metres (default 20,20) or GeoJSON footprints",
     )
     add_lot_options(derive)
     derive.add_argument(
