@@ -104,7 +104,7 @@ def build_parser() -> argparse.ArgumentParser:
     derive.add_argument(
         "--lot",
         metavar="W,D|LOTS.geojson",
-        help="the lot: width,depth in metres (default 20,20) or GeoJSON footprints",
+        help="the lot: W,D (or WxD) in metres (default 20,20) or GeoJSON footprints",
     )
     add_lot_options(derive)
     derive.add_argument(
@@ -153,10 +153,10 @@ def build_parser() -> argparse.ArgumentParser:
     render = commands.add_parser(
         "render",
         help="draw a grammar or a model into a PNG preview",
-        description="Derive FILE.bgr (or read FILE.glb / FILE.gltf) and draw it "
-        "headless into a PNG: shaded, silhouette, lines or labels.",
+        description="Derive FILE.bgr (or read a model: .glb, .gltf, .obj with its .mtl, .ply) "
+        "and draw it headless into a PNG: shaded, silhouette, lines or labels.",
     )
-    render.add_argument("file", metavar="FILE.bgr|FILE.glb")
+    render.add_argument("file", metavar="FILE.bgr|MODEL")
     render.add_argument("-o", "--output", metavar="OUT.png", help="the PNG to write")
     render.add_argument(
         "--mode",
@@ -739,6 +739,10 @@ def _progress(lots: int, output: str):
 
 
 def cmd_infer(args) -> int:
+    from .inverse.inputs import check_input
+
+    if args.kind in (None, "schema", "city", "boxes"):
+        check_input(args.input, args.kind)  # a photo or a binary file: say what is read
     kind = args.kind or _infer_kind(args.input)
     if kind == "city":
         from .inverse.city.command import run

@@ -73,7 +73,8 @@ def derive(
     """Derive a grammar on one lot or several.
 
     ``grammar`` is a checked :class:`bgr.Grammar` or anything :func:`bgr.load` takes.  ``lot`` is
-    ``(width, depth)``, ``"W,D"``, a GeoJSON path, or a list of lots; the default is 20 x 20 m.
+    ``(width, depth)``, ``"W,D"`` (or ``"WxD"``), a GeoJSON path, or a list of lots; the default
+    is 20 x 20 m.
     Each GeoJSON feature's properties override attrs of the same name for its building.
 
     What the run works around — a footprint it cannot use (skipped), a property that does not

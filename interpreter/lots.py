@@ -14,6 +14,7 @@ feature among thousands does not stop a run.
 from __future__ import annotations
 
 import math
+import re
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -263,16 +264,24 @@ def footprint(
     return Lot(Shape(origin, axes, (width, 0.0, depth), geom), dict(properties or {}), name)
 
 
+# WIDTHxDEPTH, as --size WxH: two numbers (the .bgr number syntax, checked by number_of) about
+# an x; never a file name, whether or not a file of that name exists (write ./20x30 for one)
+_BY = re.compile(r"\s*([0-9.][0-9.eE+-]*)\s*[xX]\s*([0-9.][0-9.eE+-]*)\s*")
+
+
 def parse_lot_option(
     value: str, warnings: Warnings | None = None, options: LotOptions | None = None
 ) -> list[Lot]:
-    """``W,D`` or a GeoJSON file of footprints, read with ``options`` (a W x D lot takes none)."""
-    if "," in value and not value.lower().endswith((".json", ".geojson")):
-        sides = [number_of(v) for v in value.split(",")]  # ASCII numbers only, as in .bgr
+    """``W,D`` (or ``WxD``) or a GeoJSON file of footprints, read with ``options`` (a W x D lot
+    takes none).  A value that spells two numbers is always a rectangle, never a file."""
+    by = _BY.fullmatch(value)
+    if by or ("," in value and not value.lower().endswith((".json", ".geojson"))):
+        parts = [by[1], by[2]] if by else value.split(",")
+        sides = [number_of(v) for v in parts]  # ASCII numbers only, as in .bgr
         if len(sides) != 2 or sides[0] is None or sides[1] is None:  # "nan", "1_0", "1e400"
             raise BgrError(
-                f"--lot {value[:60]}: write the lot as WIDTH,DEPTH, two numbers in metres "
-                "(e.g. 20,30), or give a GeoJSON file"
+                f"--lot {value[:60]}: write the lot as WIDTH,DEPTH (or WIDTHxDEPTH), two numbers "
+                "in metres (e.g. 20,30), or give a GeoJSON file"
             )
         if options is not None and options != LotOptions():
             raise BgrError(
@@ -308,7 +317,7 @@ def read_geojson(
     shown = str(path)
     warnings = warnings if warnings is not None else Warnings()
     options = options if options is not None else LotOptions()
-    data = read_json(path, "lot file", "give W,D or a GeoJSON file")
+    data = read_json(path, "lot file", "--lot takes W,D (or WxD) in metres, or a GeoJSON file")
     features = _features(data, shown, "lot file")
     crs = _legacy_crs(data, shown, "lot file")
 

@@ -1,8 +1,8 @@
 """What the renderer draws: world triangles with a colour, a part and a label each.
 
-Every source (a derivation ``Result``, a ``.bgr`` file, a ``.glb``/``.gltf`` file, a trimesh) is
-turned into one :class:`Scene` so that the rasterisers and the image modes never care where the
-triangles came from.
+Every source (a derivation ``Result``, a ``.bgr`` file, a ``.glb``/``.gltf``/``.obj``/``.ply``
+file, a trimesh) is turned into one :class:`Scene` so that the rasterisers and the image modes
+never care where the triangles came from.
 
 * ``part`` says where a triangle came from: the row of its terminal in the derivation's terminal
   table (so a pixel's triangle leads to the terminal's path, rule and scope), or its material's
@@ -13,11 +13,14 @@ triangles came from.
   but not terminal labels, so its triangles are labelled by material: the ``material()`` name
   when the grammar gave one, else the colour as ``#rrggbb``.  A foreign glTF file is labelled the
   same way, by its materials' names (or colours, for unnamed materials); triangles without any
-  material get the label ``(none)``.  For exact terminal labels, render the ``.bgr`` itself.
+  material get the label ``(none)``.  An ``.obj`` is labelled by material too (bgr's colour
+  materials ``c_rrggbb`` as ``#rrggbb``), a ``.ply`` by colour.  For exact terminal labels,
+  render the ``.bgr`` itself.
 """
 
 from __future__ import annotations
 
+import contextlib
 import math
 import os
 from collections.abc import Iterable
@@ -234,6 +237,143 @@ def from_gltf(path: str | os.PathLike) -> Scene:
     return from_trimesh(mesh, names, material)
 
 
+def _mtl_libraries(path: Path, data: bytes) -> tuple[dict[str, bytes], list[Diagnostic]]:
+    """The material libraries an OBJ names (``mtllib``), read from its own folder only, and a
+    warning for each that cannot be read (its faces are drawn grey)."""
+    from ..grammar.paths import read_input
+
+    shown, folder = str(path), path.resolve().parent
+    found: dict[str, bytes] = {}
+    warnings: list[Diagnostic] = []
+    seen: set[str] = set()
+    for line in data.splitlines():
+        if not line.startswith(b"mtllib"):
+            continue
+        name = line[len(b"mtllib") :].decode("utf-8", "replace").strip()
+        if not name or name in seen:
+            continue
+        seen.add(name)
+        where = (folder / name).resolve()
+        problem = None
+        if not where.is_relative_to(folder):
+            problem = "it is outside the OBJ's folder"
+        else:
+            try:
+                found[name] = read_input(where, "material library")
+            except FileNotFoundError:
+                problem = "no such file beside the OBJ"
+            except BgrError as exc:
+                problem = exc.message
+            except OSError as exc:
+                problem = exc.strerror or "unreadable"
+        if problem:
+            warnings.append(
+                Diagnostic(
+                    shown,
+                    0,
+                    0,
+                    f"material library '{name}' not read ({problem}): its faces are drawn grey",
+                    "keep the .mtl that bgr derive wrote next to the .obj",
+                    severity="warning",
+                )
+            )
+    return found, warnings
+
+
+def _material_label(name: str | None) -> str:
+    """An OBJ material's label: bgr names a colour material c_rrggbb, shown as #rrggbb."""
+    if not name:
+        return NO_LABEL
+    if len(name) == 8 and name.startswith("c_"):
+        with contextlib.suppress(ValueError):
+            int(name[2:], 16)
+            return "#" + name[2:]
+    return name
+
+
+def from_mesh_file(path: str | os.PathLike) -> Scene:
+    """A .obj (colours from the .mtl files it names, labels and parts by material) or a .ply
+    (vertex or face colours, labels and parts by colour), read with trimesh."""
+    import io
+    import logging
+
+    import trimesh
+
+    from ..grammar.paths import read_input
+
+    shown, path = str(path), Path(path)
+    fmt = path.suffix.lower().lstrip(".")
+    quiet = logging.getLogger("trimesh")
+    level = quiet.level
+    try:
+        data = read_input(path, "model file")
+        libraries, warnings = _mtl_libraries(path, data) if fmt == "obj" else ({}, [])
+        stream: io.IOBase = io.BytesIO(data)
+        if fmt == "obj":  # a text file: bytes that are not text are no OBJ
+            if b"\0" in data:
+                raise BgrError(
+                    Diagnostic(
+                        shown,
+                        0,
+                        0,
+                        "a binary file, not a Wavefront OBJ (a text file)",
+                        "bgr renders .bgr, .glb, .gltf, .obj (text, with its .mtl) and .ply files",
+                    )
+                )
+            stream = io.StringIO(data.decode("utf-8", "replace"))
+        quiet.setLevel(logging.CRITICAL)  # a missing material is said once, by the warning above
+        loaded = trimesh.load(
+            stream, file_type=fmt, resolver=libraries, process=False, force="scene"
+        )
+        meshes = [m for m in loaded.dump(concatenate=False) if len(getattr(m, "faces", ()))]
+    except FileNotFoundError:
+        raise BgrError(Diagnostic(shown, 0, 0, "no such file", "check the path")) from None
+    except BgrError as exc:
+        raise BgrError(Diagnostic(shown, 0, 0, exc.message, exc.hint)) from None
+    except OSError as exc:
+        raise BgrError(
+            Diagnostic(shown, 0, 0, f"cannot read the file: {exc.strerror or exc}")
+        ) from None
+    except Exception as exc:  # noqa: BLE001  # trimesh's parsers raise many kinds
+        raise BgrError(
+            Diagnostic(
+                shown,
+                0,
+                0,
+                f"not a .{fmt} file bgr can read ({type(exc).__name__}: {exc})"[:300],
+                "bgr reads triangle meshes (OBJ with its .mtl, PLY with vertex or face colours)",
+            )
+        ) from None
+    finally:
+        quiet.setLevel(level)
+    if not meshes:
+        raise BgrError(
+            Diagnostic(shown, 0, 0, "no triangles to draw", f"the .{fmt} file has no faces")
+        )
+    triangles, colors, names = [], [], []
+    for mesh in meshes:
+        faces = np.asarray(mesh.faces, dtype=np.int64).reshape(-1, 3)
+        triangles.append(np.asarray(mesh.vertices, dtype=np.float64)[faces])
+        material = getattr(mesh.visual, "material", None)
+        if material is not None:  # an OBJ: one material per mesh
+            rgb = np.asarray(material.main_color, dtype=np.uint8)[:3]
+            colors.append(np.tile(rgb, (len(faces), 1)))
+            names += [_material_label(getattr(material, "name", None))] * len(faces)
+        else:  # a PLY: vertex colours (averaged over a face) or face colours
+            rgb = np.asarray(mesh.visual.face_colors, dtype=np.uint8)[:, :3]
+            colors.append(rgb)
+            names += [f"#{r:02x}{g:02x}{b:02x}" for r, g, b in rgb.tolist()]
+    label, labels = _labels_index(names)
+    return Scene(
+        triangles=np.concatenate(triangles),
+        colors=np.concatenate(colors),
+        part=label.copy(),
+        label=label,
+        labels=labels,
+        warnings=warnings,
+    )
+
+
 def load_scene(
     source: Any,
     *,
@@ -250,8 +390,9 @@ def load_scene(
 ) -> Scene:
     """A :class:`Scene` from a Scene, a ``bgr.Result``, a terminal table, a trimesh, or a path to
     a ``.bgr`` (loaded with ``allow_paths`` as :func:`bgr.load`, derived with ``seed``,
-    ``attrs``, ``lot`` and ``strict``, its warnings kept in ``Scene.warnings``), ``.glb`` or
-    ``.gltf`` file.  ``lot_options`` (a LotOptions: --front, --map) go to the derivation."""
+    ``attrs``, ``lot`` and ``strict``, its warnings kept in ``Scene.warnings``), ``.glb``,
+    ``.gltf``, ``.obj`` or ``.ply`` file.  ``lot_options`` (a LotOptions: --front, --map) go to
+    the derivation."""
     if isinstance(source, Scene):
         return source
     if isinstance(source, (str, os.PathLike)):
@@ -287,13 +428,15 @@ def load_scene(
             return from_result(result)
         if suffix in (".glb", ".gltf"):
             return from_gltf(path)
+        if suffix in (".obj", ".ply"):
+            return from_mesh_file(path)
         raise BgrError(
             Diagnostic(
                 str(source),
                 0,
                 0,
                 f"cannot render a '{suffix or 'extensionless'}' file",
-                "give a .bgr grammar or a .glb/.gltf model",
+                "give a .bgr grammar or a .glb, .gltf, .obj or .ply model",
             )
         )
     if hasattr(source, "terminals") or hasattr(source, "library"):

@@ -817,10 +817,47 @@ def test_bad_input_exits_1_naming_the_boxes(tmp_path, capsys, case):
     assert code == 1
     for word in words:
         assert word in err, err
-    assert err.startswith("error: ") and err.count("\n") == 1, err
+    # as every command prints an error: FILE[:LINE:COL]: error: MESSAGE, then hint: (issue 24)
+    first = err.splitlines()[0]
+    assert first.startswith(str(tmp_path / "bad.json")) and ": error: " in first, err
+    assert all(line.startswith(("hint: ", "    ")) for line in err.splitlines()[1:]), err
     assert "Traceback" not in err and "internal error" not in err
     assert not out.exists()
     assert list(tmp_path.iterdir()) == [tmp_path / "bad.json"]  # no temporary left either
+
+
+@pytest.mark.parametrize(
+    "name, content, message",
+    [
+        ("building.bgr", "Lot --> extrude(10) Mass\n", "a grammar (.bgr), not a box hierarchy"),
+        ("photo.jpg", b"\xff\xd8\xff\xe0\x00\x10JFIF\x00", "a JPEG image, not a box hierarchy"),
+        ("boxes.json", '{"boxes": []}', 'a boxes file is an object with a "root" box'),
+        ("missing.json", None, "no such file"),
+    ],
+)
+def test_retarget_errors_print_as_every_command_does(tmp_path, capsys, name, content, message):
+    """`bgr retarget building.bgr` printed "error: building.bgr:1:1: not JSON" (issue 24): now
+    `file: error: message` and a hint saying what retarget reads, like `bgr derive` and `infer`."""
+    path = tmp_path / name
+    if isinstance(content, bytes):
+        path.write_bytes(content)
+    elif content is not None:
+        path.write_text(content)
+    assert main(["retarget", str(path), "--size", "5,4,1", "-o", str(tmp_path / "o.json")]) == 1
+    lines = capsys.readouterr().err.splitlines()
+    assert lines[0] == f"{path}: error: {message}"
+    assert len(lines) == 2 and lines[1].startswith("hint: ")
+    if content is not None:
+        assert '{"root": {"id": ...' in lines[1]
+    # an error found while retargeting names the file too
+    fixed = tmp_path / "fixed.json"
+    fixed.write_text(text(box("root", (0, 0, 0), (4, 4, 1), "FSS")))
+    assert main(["retarget", str(fixed), "--size", "5,4,1"]) == 1
+    lines = capsys.readouterr().err.splitlines()
+    assert lines == [
+        f"{fixed}: error: box 'root' is fixed (F) along x: it stays 4 m",
+        "hint: give --size with 4 for x, or tag the root S",
+    ]
 
 
 @pytest.mark.parametrize("word", ["NaN", "Infinity"])

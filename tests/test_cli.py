@@ -1,6 +1,7 @@
 """The command line: check, fmt, version, exit statuses, atomic writes."""
 
 import os
+import random
 import subprocess
 import sys
 
@@ -93,3 +94,33 @@ def test_fmt_usage_errors(tmp_path):
 def test_missing_files_are_bad_input_not_tracebacks(args):
     out = run(*args)
     assert out.returncode == 1 and "no such file" in out.stderr and "Traceback" not in out.stderr
+
+
+@pytest.mark.parametrize(
+    "name, data, what",
+    [
+        ("photo.jpg", b"\xff\xd8\xff\xe0\x00\x10JFIF\x00\x01" + bytes(range(256)), "a JPEG image"),
+        ("plan.png", b"\x89PNG\r\n\x1a\n\x00\x00\x00\rIHDR" + bytes(64), "a PNG image"),
+        ("noise", random.Random(24).randbytes(4096), "a binary file"),
+        ("notes.txt", b"width 12 m\n", "a '.txt' file"),
+    ],
+)
+def test_infer_names_what_a_file_is_not_and_what_it_reads(tmp_path, name, data, what):
+    """`bgr infer photo.jpg` said "'utf-8' codec can't decode byte 0xff" (issue 24)."""
+    path = tmp_path / name
+    path.write_bytes(data)
+    out = run("infer", str(path))
+    assert out.returncode == 1 and "Traceback" not in out.stderr and "codec" not in out.stderr
+    first, hint = out.stderr.splitlines()
+    assert first == f"{path}: error: {what}" + first.split(what, 1)[1]
+    assert first.endswith(", not an input bgr infer reads")
+    for kind in ("--kind schema", "--kind city", "--kind boxes", ".bgr", ".obj", ".city.json"):
+        assert kind in hint
+    # the same bytes as a .json, or with --kind schema or boxes: still what it is, not a codec
+    if what != "a '.txt' file":
+        for args in (["--kind", "schema"], ["--kind", "boxes"]):
+            out = run("infer", str(path), *args)
+            assert out.returncode == 1 and out.stderr.startswith(f"{path}: error: {what}")
+        (tmp_path / "x.json").write_bytes(data)
+        out = run("infer", str(tmp_path / "x.json"))
+        assert out.returncode == 1 and f"error: {what}" in out.stderr

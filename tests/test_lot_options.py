@@ -229,6 +229,36 @@ def test_cli_map(tmp_path):
     assert proc.returncode == 2 and "apply to a GeoJSON lot file" in proc.stderr
 
 
+@pytest.mark.parametrize("text", ["20x30", "20X30", " 20 x 30 ", "20.0x3e1"])
+def test_lot_takes_w_by_d_as_size_does(tmp_path, monkeypatch, text):
+    """`bgr derive house.bgr --lot 20x20` said "no such lot file" (issue 24): WxD is W,D."""
+    src = tmp_path / "floors.bgr"
+    src.write_text(FLOORS)
+    out = tmp_path / "out.json"
+    proc = bgr_cli("derive", src, "--lot", text, "-o", out)
+    assert proc.returncode == 0, proc.stderr
+    lot = json.loads(out.read_text())["lots"][0]
+    assert lot["size"] == [20.0, 0.0, 30.0]
+    assert bgr.derive(bgr.load(src), lot=text).terminals.size.tolist() == [[20.0, 6.0, 30.0]]
+    # two numbers are a rectangle even beside a file of that name; ./NAME is the file
+    monkeypatch.chdir(tmp_path)
+    write(tmp_path / "20x30", feature([box(0, 0)]))
+    assert bgr.derive(bgr.load(src), lot="20x30").terminals.size.tolist() == [[20.0, 6.0, 30.0]]
+    assert bgr.derive(bgr.load(src), lot="./20x30").terminals.size[0, 0] != 20.0
+
+
+def test_a_lot_that_is_neither_says_what_lot_takes(tmp_path):
+    src = tmp_path / "floors.bgr"
+    src.write_text(FLOORS)
+    proc = bgr_cli("derive", src, "--lot", "20*20", "-o", tmp_path / "out.json")
+    assert proc.returncode == 1 and proc.stderr.splitlines() == [
+        "20*20: error: no such lot file",
+        "hint: --lot takes W,D (or WxD) in metres, or a GeoJSON file",
+    ]
+    proc = bgr_cli("derive", src, "--lot", "1e400x3", "-o", tmp_path / "out.json")
+    assert proc.returncode == 1 and "write the lot as WIDTH,DEPTH (or WIDTHxDEPTH)" in proc.stderr
+
+
 def test_render_takes_map_and_front(tmp_path):
     src = tmp_path / "floors.bgr"
     src.write_text(FLOORS)

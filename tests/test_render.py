@@ -443,6 +443,57 @@ def test_glb_scene_labels_by_material(tmp_path):
     assert (np.abs(a.astype(int) - b.astype(int)).max(axis=2) > 2).mean() < 0.01
 
 
+@pytest.mark.parametrize("ext", ["obj", "ply"])
+def test_obj_and_ply_that_derive_writes_render_in_their_colours(tmp_path, capsys, ext):
+    """`bgr derive examples/house.bgr -o h.obj && bgr render h.obj -o h.png` (issue 24): the OBJ
+    is read with its .mtl, the PLY with its vertex colours; the picture is the grammar's."""
+    result = bgr.derive(HOUSE, seed=3)
+    path = tmp_path / f"house.{ext}"
+    assert main(["derive", str(HOUSE), "--seed", "3", "-o", str(path)]) == 0
+    scene = load_scene(path)
+    assert len(scene) == result.terminals.triangle_count() and scene.warnings == []
+    assert set(scene.labels) == {"#5a6a7a", "#7a3b2e", "#cccccc", "#d8c8a8"}
+    a = render(scene, "shaded", "front", size=(200, 150), backend="numpy")
+    b = render(result, "shaded", "front", size=(200, 150), backend="numpy")
+    assert (np.abs(a.astype(int) - b.astype(int)).max(axis=2) > 2).mean() < 0.01
+    out = tmp_path / "h.png"
+    assert main(["render", str(path), "-o", str(out), "--size", "80x60"]) == 0
+    assert out.is_file() and "80x60 shaded" in capsys.readouterr().err
+
+
+def test_obj_without_its_mtl_is_drawn_grey_with_a_warning(tmp_path, capsys):
+    path = tmp_path / "house.obj"
+    bgr.derive(HOUSE, seed=3).save(path)
+    (tmp_path / "house.mtl").unlink()
+    assert main(["render", str(path), "-o", str(tmp_path / "h.png"), "--size", "80x60"]) == 0
+    err = capsys.readouterr().err
+    assert "warning: material library 'house.mtl' not read" in err and "Traceback" not in err
+    # an mtllib outside the OBJ's folder is not read
+    (tmp_path / "sub").mkdir()
+    text = path.read_text().replace("mtllib house.mtl", "mtllib ../secret.mtl")
+    (tmp_path / "sub" / "x.obj").write_text(text)
+    (tmp_path / "secret.mtl").write_text("newmtl c_d8c8a8\nKd 1 0 0\n")
+    scene = load_scene(tmp_path / "sub" / "x.obj")
+    assert "outside the OBJ's folder" in scene.warnings[0].message
+    assert not (scene.colors == [255, 0, 0]).all(axis=1).any()
+
+
+@pytest.mark.parametrize(
+    "name, data, words",
+    [
+        ("x.obj", bytes(range(256)) * 4, "a binary file, not a Wavefront OBJ"),
+        ("x.ply", b"\x89PNG\r\n\x1a\n" + bytes(200), "not a .ply file bgr can read"),
+        ("x.obj", b"# nothing\nv 0 0 0\n", "no triangles to draw"),
+        ("x.ply", b"", "not a .ply file bgr can read"),
+    ],
+)
+def test_bad_obj_and_ply_are_one_error(tmp_path, capsys, name, data, words):
+    (tmp_path / name).write_bytes(data)
+    assert main(["render", str(tmp_path / name), "-o", str(tmp_path / "x.png")]) == 1
+    err = capsys.readouterr().err
+    assert words in err and "Traceback" not in err and not (tmp_path / "x.png").exists()
+
+
 # --- files and the command line ----------------------------------------------------------------
 
 

@@ -151,6 +151,78 @@ def test_mass_facade_and_window_compose_in_under_fifteen_lines(tmp_path):
     assert out.stat().st_size > 1000
 
 
+# ---- bands and cornices at the corners ---------------------------------------------------------
+
+
+def _corner_overruns(result, footprint, prefix: str = "") -> list[str]:
+    """Façade bands and cornices of a building on a convex ``footprint`` ((x, z) world points)
+    that go past a corner further than the corner's bisector: out of a side wall by more than out
+    of their own wall.  A bar's wall is the footprint edge it stands furthest out of."""
+    from bgr.interpreter.terminals import world_vertices
+
+    pts = np.asarray(footprint, dtype=float)
+    nxt = np.roll(pts, -1, axis=0)
+    if (pts[:, 0] * nxt[:, 1] - nxt[:, 0] * pts[:, 1]).sum() < 0:  # counter-clockwise in (x, z)
+        pts = pts[::-1]
+    edges = np.roll(pts, -1, axis=0) - pts
+    normals = np.stack([edges[:, 1], -edges[:, 0]], axis=1)  # outward
+    normals /= np.linalg.norm(normals, axis=1)[:, None]
+    t = result.terminals
+    bad = []
+    for row, (label, path) in enumerate(zip(t.label, t.path, strict=True)):
+        if label not in ("Cornice", "Trim") or "/_Face." not in path or not path.startswith(prefix):
+            continue
+        mesh = t.library.meshes[t.mesh[row]]
+        xz = world_vertices(t, np.array([row]), mesh)[0][:, [0, 2]]
+        out = np.einsum("ej,vj->ve", normals, xz) - np.einsum("ej,ej->e", normals, pts)
+        own = int(np.argmax(out.mean(axis=0)))
+        past = (out - out[:, [own]]).max()
+        if past > 1e-6 or out[:, own].max() > 0.6:
+            bad.append(f"{path}: {past:.2f} m past a corner, {out[:, own].max():.2f} m out")
+    return bad
+
+
+def test_street_gable_cornice_ends_at_the_corners():
+    """The red gable house of examples/stdlib_street.bgr (lot 3 of block.geojson, seed 5): its
+    street façade's cornice stood 0.45 m out past the gable walls, which have none."""
+    import json
+
+    lots = json.loads((ROOT / "examples" / "block.geojson").read_text(encoding="utf-8"))
+    ring = lots["features"][2]["geometry"]["coordinates"][0][:-1]
+    result = bgr.derive(
+        bgr.load(ROOT / "examples" / "stdlib_street.bgr"),
+        seed=5,
+        lot=str(ROOT / "examples" / "block.geojson"),
+    )
+    house = "Lot.2/GableHouse."
+    t = result.terminals
+    cornices = [
+        p
+        for p, lab in zip(t.path, t.label, strict=True)
+        if p.startswith(house) and lab == "Cornice"
+    ]
+    assert len(cornices) >= 2, "the street façade has no cornice any more"
+    assert _corner_overruns(result, [(x, -y) for x, y in ring], house) == []
+
+
+@pytest.mark.parametrize("facade", ["Attic", "Tripartite", "Palazzo"])
+def test_bands_meet_round_every_corner_of_a_block(tmp_path, facade):
+    """The same façade all round a five-sided block: each band is mitred at every corner."""
+    ring = [(0, 0), (14, 0), (17, 8), (9, 13), (0, 10)]
+    lot = tmp_path / "lot.geojson"
+    lot.write_text(
+        '{"type": "Feature", "properties": {}, "geometry": {"type": "Polygon", '
+        f'"coordinates": [{[list(p) for p in ring + ring[:1]]}]}}}}'
+    )
+    src = (
+        "import stdlib.mass as mass\nimport stdlib.facade as fac\n"
+        f"Lot --> mass.Block(h = 12, facade = fac.{facade})\n"
+    )
+    result = bgr.derive(bgr.load(src, path=tmp_path / "b.bgr"), seed=1, lot=str(lot))
+    assert "Cornice" in result.terminals.label or "Trim" in result.terminals.label
+    assert _corner_overruns(result, [(x, -y) for x, y in ring]) == []
+
+
 # ---- the generated reference -----------------------------------------------------------------
 
 

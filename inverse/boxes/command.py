@@ -5,13 +5,14 @@ from __future__ import annotations
 import math
 import re
 import sys
+from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
 from bgr.formats.atomic import write_text as write_atomic
-from bgr.grammar.errors import BgrError
+from bgr.grammar.errors import BgrError, Diagnostic
 from bgr.grammar.formatter import format_module
 from bgr.grammar.paths import check_input, roots_of, within
 
@@ -41,21 +42,24 @@ def run_retarget(args) -> int:
         size = parse_size(args.size)
         check_order(args.order)
     except (ValueError, BgrError) as e:
-        print(f"bgr retarget: {e}", file=sys.stderr)
+        print(f"bgr retarget: {getattr(e, 'message', e)}", file=sys.stderr)
         return USAGE
     out = None if args.output in (None, "-") else Path(args.output)
     source = Path(args.input)
     root = read(source)
-    result = retarget(root, size, args.order, max_boxes=args.max_boxes)
-    kept, total = alignments(root, result)
-    if out is None or out.name.lower().endswith(".json") and not _mesh_json(out):
-        text = dumps(result)
-        if out is None:
-            sys.stdout.write(text)
+    try:
+        result = retarget(root, size, args.order, max_boxes=args.max_boxes)
+        kept, total = alignments(root, result)
+        if out is None or out.name.lower().endswith(".json") and not _mesh_json(out):
+            text = dumps(result)
+            if out is None:
+                sys.stdout.write(text)
+            else:
+                write_atomic(out, text)
         else:
-            write_atomic(out, text)
-    else:
-        save_mesh(result, roots_of(source.parent, args.allow_path), source.parent, out)
+            save_mesh(result, roots_of(source.parent, args.allow_path), source.parent, out)
+    except BgrError as e:
+        raise located(e, source) from None
     boxes = sum(1 for _ in result.walk())
     print(
         f"{args.output or '<stdout>'}: {boxes} boxes ({sum(1 for _ in root.walk())} in the input), "
@@ -63,6 +67,14 @@ def run_retarget(args) -> int:
         file=sys.stderr,
     )
     return 0
+
+
+def located(error: BgrError, source: Path) -> BgrError:
+    """``error`` about the boxes file ``source`` where it names no file of its own, so that it
+    prints as every bgr command's errors do: ``source: error: message``, then ``hint:``."""
+    if error.path:
+        return error
+    return BgrError([replace(d, path=str(source)) for d in error.diagnostics])
 
 
 def _mesh_json(path: Path) -> bool:
@@ -118,8 +130,13 @@ def _load_part(roots: tuple[Path, ...], base: Path, mesh: str):
     path = base / mesh
     if not within(path, roots):
         raise BgrError(
-            f"mesh '{mesh}' is outside the boxes file's folder ({base}); "
-            "let bgr read it with --allow-path DIR"
+            Diagnostic(
+                "",
+                0,
+                0,
+                f"mesh '{mesh}' is outside the boxes file's folder ({base})",
+                "let bgr read it with --allow-path DIR",
+            )
         )
     check_input(path, "mesh")
     if not path.is_file():
@@ -225,7 +242,10 @@ def run_infer(args) -> int:
     source = Path(args.input)
     root = read(source)
     out = None if args.output in (None, "-") else Path(args.output)
-    written = write(root, str(args.input), source.parent, (out or Path("x")).parent)
+    try:
+        written = write(root, str(args.input), source.parent, (out or Path("x")).parent)
+    except BgrError as e:
+        raise located(e, source) from None
     text = format_module(written.module)
     if out is None:
         sys.stdout.write(text)

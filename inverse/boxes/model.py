@@ -17,12 +17,27 @@ from pathlib import Path
 
 import numpy as np
 
-from bgr.grammar.errors import BgrError
+from bgr.grammar.errors import BgrError, Diagnostic
 from bgr.grammar.paths import read_input
 
 AXES = "xyz"
 BEHAVIOURS = ("S", "R", "F")
 EPS = 1e-6  # metres: faces closer than this coincide (the paper's epsilon-precision)
+FORMAT = '{"root": {"id": ..., "min": [x, y, z], "max": [x, y, z], "children": [...]}}'
+READS = f"a boxes file is a JSON object {FORMAT} (docs/inverse-boxes.md)"
+
+
+def _fail(
+    name: str | Path,
+    message: str,
+    hint: str | None = None,
+    line: int = 0,
+    column: int = 0,
+    text=None,
+) -> BgrError:
+    """An error in the boxes file ``name``, as every bgr command prints one (``file:line:col:
+    error: message``, then ``hint:``)."""
+    return BgrError(Diagnostic(str(name), line, column, message, hint, text))
 
 
 @dataclass
@@ -100,15 +115,26 @@ def read(path: str | Path) -> Box:
     """The hierarchy in a boxes JSON file, checked (:func:`parse`)."""
     path = Path(path)
     try:
-        text = read_input(path, "boxes file").decode("utf-8-sig")  # a byte-order mark is fine
+        data = read_input(path, "boxes file")
+        text = data.decode("utf-8-sig")  # a byte-order mark is fine
     except FileNotFoundError:
-        raise BgrError(f"{path}: no such file") from None
+        raise _fail(path, "no such file", "check the path") from None
     except IsADirectoryError:
-        raise BgrError(f"{path}: is a folder, not a boxes .json file") from None
+        raise _fail(path, "is a folder, not a boxes .json file", READS) from None
     except UnicodeDecodeError as e:
-        raise BgrError(f"{path}: not UTF-8 text (byte {e.start})") from None
+        from bgr.inverse.inputs import describe
+
+        what = describe(data[:65536]) or f"not UTF-8 text (byte {e.start})"
+        raise _fail(path, f"{what}, not a box hierarchy", READS) from None
     except OSError as e:
-        raise BgrError(f"{path}: cannot read: {e.strerror}") from None
+        raise _fail(path, f"cannot read the file: {e.strerror}") from None
+    if path.suffix.lower() == ".bgr":
+        raise _fail(
+            path,
+            "a grammar (.bgr), not a box hierarchy",
+            f"{READS}; a grammar is resized by bgr derive --lot W,D (or --set), and bgr infer "
+            "--kind schema infers from one",
+        )
     return parse(text, str(path))
 
 
@@ -118,28 +144,28 @@ def parse(text: str, name: str = "<boxes>") -> Box:
     try:
         doc = json.loads(text, parse_constant=_no_constant)
     except json.JSONDecodeError as e:
-        raise BgrError(f"{name}:{e.lineno}:{e.colno}: not JSON: {e.msg}") from None
+        lines = text.splitlines()
+        shown = lines[e.lineno - 1] if 0 < e.lineno <= len(lines) else None
+        raise _fail(name, f"not JSON: {e.msg}", READS, e.lineno, e.colno, shown) from None
     except ValueError as e:
-        raise BgrError(f"{name}: {e}") from None
+        raise _fail(name, str(e)) from None
     except RecursionError:
-        raise BgrError(f"{name}: nested too deeply to read") from None
+        raise _fail(name, "nested too deeply to read") from None
     if not isinstance(doc, dict) or not isinstance(doc.get("root"), dict):
-        raise BgrError(
-            f'{name}: a boxes file is an object with a "root" box: '
-            '{"root": {"id": ..., "min": [x, y, z], "max": [x, y, z], "children": [...]}}'
-        )
+        raise _fail(name, 'a boxes file is an object with a "root" box', f"write {FORMAT}")
     extra = sorted(set(doc) - {"root"})
     if extra:
-        raise BgrError(
-            f'{name}: unknown key(s) {", ".join(map(repr, extra))} beside "root"; a boxes file '
-            'holds only {"root": ...}'
+        raise _fail(
+            name,
+            f'unknown key(s) {", ".join(map(repr, extra))} beside "root"',
+            'a boxes file holds only {"root": ...}',
         )
     ids: dict[str, str] = {}
     root = _box(doc["root"], name, "root", ids, fixed=(False, False, False))
     problems = check(root)
     if problems:
         more = f" (and {len(problems) - 5} more)" if len(problems) > 5 else ""
-        raise BgrError(f"{name}: " + "; ".join(problems[:5]) + more)
+        raise _fail(name, "; ".join(problems[:5]) + more)
     return root
 
 
@@ -159,19 +185,20 @@ def _no_constant(word: str) -> _Constant:
 
 def _box(obj, name: str, where: str, ids: dict, fixed: tuple[bool, bool, bool]) -> Box:
     if not isinstance(obj, dict):
-        raise BgrError(f"{name}: {where} is not a box object")
+        raise _fail(name, f"{where} is not a box object")
     box_id = obj.get("id")
     if not isinstance(box_id, str) or not box_id.strip():
-        raise BgrError(f'{name}: {where} has no "id" (a non-empty string)')
+        raise _fail(name, f'{where} has no "id" (a non-empty string)')
     here = f"box '{box_id}'"
     if box_id in ids:
-        raise BgrError(f"{name}: two boxes have the id '{box_id}' ({ids[box_id]} and {where})")
+        raise _fail(name, f"two boxes have the id '{box_id}' ({ids[box_id]} and {where})")
     ids[box_id] = where
     unknown = set(obj) - {"id", "min", "max", "behavior", "mesh", "children", "source", "replica"}
     if unknown:
-        raise BgrError(
-            f"{name}: {here} has unknown key(s) {', '.join(sorted(unknown))}; a box has id, min, "
-            "max, behavior, mesh and children"
+        raise _fail(
+            name,
+            f"{here} has unknown key(s) {', '.join(sorted(unknown))}",
+            "a box has id, min, max, behavior, mesh and children",
         )
     corners = []
     for key in ("min", "max"):
@@ -180,55 +207,57 @@ def _box(obj, name: str, where: str, ids: dict, fixed: tuple[bool, bool, bool]) 
             next((c for c in v if isinstance(c, _Constant)), None) if isinstance(v, list) else None
         )
         if constant is not None:
-            raise BgrError(
-                f'{name}: {here}: "{key}" holds {constant}, which is not a number a box may have'
+            raise _fail(
+                name, f'{here}: "{key}" holds {constant}, which is not a number a box may have'
             )
         if (
             not isinstance(v, list)
             or len(v) != 3
             or not all(isinstance(c, int | float) and not isinstance(c, bool) for c in v)
         ):
-            raise BgrError(f'{name}: {here}: "{key}" must be three numbers [x, y, z]')
+            raise _fail(name, f'{here}: "{key}" must be three numbers [x, y, z]')
         if not all(math.isfinite(c) and abs(c) < 1e9 for c in v):
-            raise BgrError(
-                f'{name}: {here}: "{key}" holds a number that is not finite or is beyond 1e9 m'
+            raise _fail(
+                name, f'{here}: "{key}" holds a number that is not finite or is beyond 1e9 m'
             )
         corners.append(np.array(v, dtype=np.float64))
     lo, hi = corners
     if np.any(hi - lo <= EPS):
         axis = AXES[int(np.argmax(hi - lo <= EPS))]
-        raise BgrError(
-            f"{name}: {here}: max must exceed min on every axis (along {axis}: "
-            f"{lo[AXES.index(axis)]:g} to {hi[AXES.index(axis)]:g})"
+        raise _fail(
+            name,
+            f"{here}: max must exceed min on every axis (along {axis}: "
+            f"{lo[AXES.index(axis)]:g} to {hi[AXES.index(axis)]:g})",
         )
     behavior = obj.get("behavior", {})
     if not isinstance(behavior, dict):
-        raise BgrError(f'{name}: {here}: "behavior" must be an object such as {{"x": "R"}}')
+        raise _fail(name, f'{here}: "behavior" must be an object such as {{"x": "R"}}')
     tags = []
     for i, axis in enumerate(AXES):
         tag = behavior.get(axis, "F" if fixed[i] else "S")
         if tag not in BEHAVIOURS:
-            raise BgrError(
-                f"{name}: {here}: behavior {axis} is {json.dumps(tag, default=str)}; "
-                "write S (scale), R (replicate) or F (fixed)"
+            raise _fail(
+                name,
+                f"{here}: behavior {axis} is {json.dumps(tag, default=str)}",
+                "write S (scale), R (replicate) or F (fixed)",
             )
         # an F box's descendants keep their size along that axis whatever they say
         tags.append("F" if fixed[i] else tag)
     extra = set(behavior) - set(AXES)
     if extra:
-        raise BgrError(f"{name}: {here}: behavior has axis {sorted(extra)[0]!r}; use x, y, z")
+        raise _fail(name, f"{here}: behavior has axis {sorted(extra)[0]!r}", "use x, y, z")
     mesh = obj.get("mesh")
     if mesh is not None and (not isinstance(mesh, str) or not mesh.strip()):
-        raise BgrError(f'{name}: {here}: "mesh" must be a file path')
+        raise _fail(name, f'{here}: "mesh" must be a file path')
     children = obj.get("children", [])
     if not isinstance(children, list):
-        raise BgrError(f'{name}: {here}: "children" must be a list of boxes')
+        raise _fail(name, f'{here}: "children" must be a list of boxes')
     source = obj.get("source", box_id)
     replica = obj.get("replica", 0)
     if not isinstance(source, str) or not source.strip():
-        raise BgrError(f'{name}: {here}: "source" must be the id of the box it is a copy of')
+        raise _fail(name, f'{here}: "source" must be the id of the box it is a copy of')
     if not isinstance(replica, int) or isinstance(replica, bool) or replica < 0:
-        raise BgrError(f'{name}: {here}: "replica" must be a whole number, 0 or more')
+        raise _fail(name, f'{here}: "replica" must be a whole number, 0 or more')
     now = (tags[0] == "F", tags[1] == "F", tags[2] == "F")
     kids = [_box(c, name, f"child {k} of '{box_id}'", ids, now) for k, c in enumerate(children)]
     return Box(box_id, lo, hi, (tags[0], tags[1], tags[2]), mesh, kids, source, replica)

@@ -32,7 +32,7 @@ from collections.abc import Sequence as Seq
 
 import numpy as np
 
-from bgr.grammar.errors import BgrError
+from bgr.grammar.errors import BgrError, Diagnostic
 
 from .analysis import Analysis, Sequence, Unit, analyse, min_length
 from .model import AXES, EPS, Box
@@ -75,8 +75,13 @@ def retarget_axis(
         return root
     if root.tags[axis] == "F":
         raise BgrError(
-            f"box '{root.id}' is fixed (F) along {name}: it stays {now:g} m; "
-            f"give --size with {now:g} for {name}, or tag the root S"
+            Diagnostic(
+                "",
+                0,
+                0,
+                f"box '{root.id}' is fixed (F) along {name}: it stays {now:g} m",
+                f"give --size with {now:g} for {name}, or tag the root S",
+            )
         )
     shortest = min_length(root, axis)
     if length < shortest - EPS:
@@ -191,9 +196,14 @@ class Retargeter:
         self.boxes += size * (p.count - 1)
         if self.boxes > self.max_boxes:
             raise BgrError(
-                f"the result would have more than {self.max_boxes:,} boxes ('{kids[i].source}' "
-                f"repeated {p.count:,} times along {AXES[self.axis]}): ask a smaller size, or "
-                "raise --max-boxes"
+                Diagnostic(
+                    "",
+                    0,
+                    0,
+                    f"the result would have more than {self.max_boxes:,} boxes "
+                    f"('{kids[i].source}' repeated {p.count:,} times along {AXES[self.axis]})",
+                    "ask a smaller size, or raise --max-boxes",
+                )
             )
         copies[i] = [self.replicate(kids[i], c * step, c) for c in range(1, p.count)]
 

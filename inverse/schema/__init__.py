@@ -60,7 +60,8 @@ def read_model(
         model.source = shown
         return model
     try:
-        text = read_input(path, "input file").decode("utf-8")
+        data = read_input(path, "input file")
+        text = data.decode("utf-8")
     except FileNotFoundError:
         raise BgrError(
             Diagnostic(
@@ -71,7 +72,11 @@ def read_model(
                 "give a terminal list (bgr derive -o x.json), a captured-model .json or a .bgr",
             )
         ) from None
-    except (OSError, UnicodeDecodeError) as exc:
+    except UnicodeDecodeError:
+        from ..inputs import not_text
+
+        raise not_text(shown, data[: 1 << 16]) from None
+    except OSError as exc:
         raise BgrError(Diagnostic(shown, 0, 0, f"cannot read the file: {exc}")) from None
     from .captured import parse  # strict JSON: line and column, duplicate keys, no NaN
 
