@@ -229,8 +229,9 @@ def build_parser() -> argparse.ArgumentParser:
     infer.add_argument(
         "input",
         metavar="INPUT",
-        help="a city (.obj, .ply, .glb, .gltf, .city.json, .city.jsonl), or a terminal list "
-        ".json, captured-model .json or .bgr for --kind schema",
+        help="a city (.obj, .ply, .glb, .gltf, .city.json, .city.jsonl), a box hierarchy "
+        ".json for --kind boxes, or a terminal list .json, captured-model .json or .bgr for "
+        "--kind schema",
     )
     infer.add_argument(
         "--kind",
