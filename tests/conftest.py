@@ -2,6 +2,13 @@ import os
 from pathlib import Path
 
 import pytest
+from hypothesis import settings
+
+# no per-example deadline anywhere: the suite runs two processes on two cores beside whatever
+# else the machine does, and a slow example is not a failure (what a case may cost is bounded
+# by the timing tests that say so)
+settings.register_profile("bgr", deadline=None)
+settings.load_profile("bgr")
 
 ROOT = Path(__file__).resolve().parent.parent
 SHARED = ROOT.parent / "shared"

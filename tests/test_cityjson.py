@@ -682,38 +682,56 @@ REPAIRED = {17426424, 19993762, 19994142, 22498879, 22954656, 123412759, 1235239
 SIMPLE = "terminal Roof, Wall\nLot --> extrude(10) comp(f) { top: Roof | side: Wall }\n"
 
 
-@pytest.fixture(scope="module")
-def helsinki(tmp_path_factory):
+# the default run takes every sixth feature (81 buildings, ~30 s less); `pytest -m slow` all 486
+HELSINKI_PARTS = [
+    pytest.param(6, id="sixth"),
+    pytest.param(1, id="whole", marks=pytest.mark.slow),
+]
+
+
+@pytest.fixture(scope="module", params=HELSINKI_PARTS)
+def helsinki(request, tmp_path_factory):
     if not HELSINKI.exists():
         pytest.skip(f"the Helsinki footprints are not here ({HELSINKI})")
     folder = tmp_path_factory.mktemp("helsinki")
-    result = bgr.derive(SIMPLE, lot=str(HELSINKI))
+    lots = HELSINKI
+    if request.param > 1:
+        data = json.loads(HELSINKI.read_text(encoding="utf-8"))
+        data["features"] = data["features"][:: request.param]
+        lots = folder / "part.geojson"
+        lots.write_text(json.dumps(data), encoding="utf-8")
+    result = bgr.derive(SIMPLE, lot=str(lots))
     one, seq = folder / "helsinki.city.json", folder / "helsinki.city.jsonl"
     result.save(one)
     result.save(seq)
-    return result, one, seq
+    # 481 buildings of 486 features: one MultiPolygon of two, six features with no area
+    expected = 481 if request.param == 1 else None
+    return result, one, seq, expected
 
 
+@pytest.mark.xdist_group("helsinki_cityjson")
 def test_helsinki_validates_and_loads_in_cjio(helsinki):
-    result, one, seq = helsinki
+    result, one, seq, expected = helsinki
     for path in (one, seq):
         assert schema_errors(path) == []
         check_rules(path)
     loaded = cjio_load(one)
-    assert loaded["objects"] == loaded["level1"] == len(result.terminals.lots) == 481
+    count = len(result.terminals.lots)
+    assert loaded["objects"] == loaded["level1"] == count == (expected or count) > 60
     assert loaded["epsg"] == 32635
-    assert cjio_load(seq)["objects"] == 481
+    assert cjio_load(seq)["objects"] == count
     doc = json.loads(one.read_text())
     assert doc["metadata"]["referenceSystem"] == "https://www.opengis.net/def/crs/EPSG/0/32635"
     assert pyproj.CRS.from_user_input(doc["metadata"]["referenceSystem"]).is_projected
 
 
+@pytest.mark.xdist_group("helsinki_cityjson")
 def test_helsinki_buildings_sit_on_their_footprints(helsinki):
     """Each building's ground corners, read back from the file, lie on its footprint's outline
     or on one of its courtyards' as pyproj projects them here from the GeoJSON's longitude and
     latitude (to 1 cm: the lot reader drops corners within 1 mm of a line, the grid rounds to
     1 mm), and reach its extremes."""
-    _, one, _ = helsinki
+    result, one, _, expected = helsinki
     model = read_cityjson(one)
     to_utm = pyproj.Transformer.from_crs("OGC:CRS84", "EPSG:32635", always_xy=True)
     features = json.loads(HELSINKI.read_text())["features"]
@@ -737,4 +755,5 @@ def test_helsinki_buildings_sit_on_their_footprints(helsinki):
         top = building.vertices[:, 2].max()
         assert top == pytest.approx(10.0, abs=1e-3)
         checked += 1
-    assert checked > 450
+    # all but the repaired and the split ones
+    assert checked > (450 if expected else 0.9 * len(result.terminals.lots))

@@ -138,6 +138,7 @@ def test_grid_city_validates(validator, tmp_path):
     assert lot.name == "lot-0" and len(lot.children) >= 3  # its labels
 
 
+@pytest.mark.slow
 def test_helsinki_street_validates_with_a_node_per_footprint(validator, tmp_path):
     if not HELSINKI.exists():
         pytest.skip(f"{HELSINKI} is absent (the shared real-data folder)")

@@ -93,9 +93,18 @@ def test_every_facade_and_window_derives_on_three_sizes_and_five_seeds(modules, 
                 _assert_mesh(result, f"{mod}.{name} on {w} x {h} m, seed {seed}")
 
 
-def test_every_mass_derives_on_three_lots_and_five_seeds(modules):
+def _chunks(names: list[str], size: int) -> list[list[str]]:
+    return [names[i : i + size] for i in range(0, len(names), size)]
+
+
+# the 30 masses in six tests of five, so that the suite's processes share them out
+MASS_CHUNKS = _chunks(public(module("mass")), 5)
+
+
+@pytest.mark.parametrize("names", MASS_CHUNKS, ids=[c[0] for c in MASS_CHUNKS])
+def test_every_mass_derives_on_three_lots_and_five_seeds(modules, names):
     grammar = modules["mass"]
-    for name in public(grammar):
+    for name in names:
         for lot in [(8, 6), (20, 15), (45, 30)]:
             for seed in SEEDS:
                 result = bgr.derive(grammar, seed=seed, lot=lot, start=name)
