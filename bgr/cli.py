@@ -538,18 +538,18 @@ def _read(name: str) -> tuple[str, str]:
 def cmd_check(args) -> int:
     status = EXIT_OK
     for name in args.files:
+        shown = "<stdin>" if name == "-" else name
         try:
-            if name == "-":
-                text, _ = _read(name)
-                load(text, path="<stdin>", allow_paths=args.allow_path)
-            else:
-                load(Path(name), path=name, allow_paths=args.allow_path)
+            source = _read(name)[0] if name == "-" else Path(name)
+            grammar = load(source, path=shown, allow_paths=args.allow_path)
         except BgrError as e:
             print(e.render(), file=sys.stderr)
             status = EXIT_INPUT
             continue
+        print(*(w.render() + "\n" for w in grammar.warnings), sep="", end="", file=sys.stderr)
+        count = len(grammar.warnings)  # the file checks: warnings leave the status at 0
         if not args.quiet:
-            print(f"{'<stdin>' if name == '-' else name}: ok")
+            print(f"{shown}: ok" + (f" ({count} warning{'s' * (count > 1)})" if count else ""))
     return status
 
 

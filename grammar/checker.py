@@ -57,11 +57,10 @@ _RESERVED_ALIASES = {"scope", "split", "comp", "stdlib", "geometry"}
 
 @dataclass
 class Grammar:
-    """A checked module: its tree, its symbol tables and its imported modules.
+    """A checked module: its tree, its symbol tables, its imported modules and its warnings.
 
     Names are resolved per module: a rule of an imported module refers to that module's own
-    rules, attrs and functions; the importer reaches them as ``alias.Name``.
-    """
+    rules, attrs and functions; the importer reaches them as ``alias.Name``."""
 
     path: str
     module: n.Module
@@ -80,6 +79,7 @@ class Grammar:
     # levels of each func's body, the bodies of the funcs it calls included (grammar.limits)
     func_depths: dict[str, int] = field(default_factory=dict)
     recursive_funcs: set[str] = field(default_factory=set)  # funcs that call themselves
+    warnings: list[Diagnostic] = field(default_factory=list)  # bgr.load: its own and its imports'
 
     def lookup_module(self, dotted: str) -> tuple[Grammar, str]:
         """Split ``alias.Name`` into (module, member); a plain name is this module's own."""
