@@ -80,6 +80,7 @@ class Grammar:
     func_depths: dict[str, int] = field(default_factory=dict)
     recursive_funcs: set[str] = field(default_factory=set)  # funcs that call themselves
     warnings: list[Diagnostic] = field(default_factory=list)  # bgr.load: its own and its imports'
+    barren: dict[str, str] = field(default_factory=dict)  # rule -> its cycle (.productive)
 
     def lookup_module(self, dotted: str) -> tuple[Grammar, str]:
         """Split ``alias.Name`` into (module, member); a plain name is this module's own."""
@@ -241,11 +242,10 @@ class Checker:
     def unique_params(self, item: n.Rule | n.Func, what: str) -> None:
         seen = set()
         for i, p in enumerate(item.params):
+            pos = item.param_pos[i] if i < len(item.param_pos) else item.pos
             if p in KEYWORDS:
-                pos = item.param_pos[i] if i < len(item.param_pos) else item.pos
                 self.error(pos, f"'{p}' is a keyword and cannot name a parameter", length=len(p))
             if p in seen:
-                pos = item.param_pos[i] if i < len(item.param_pos) else item.pos
                 self.error(pos, f"parameter '{p}' appears twice in this {what}", length=len(p))
             seen.add(p)
         if isinstance(item, n.Rule):

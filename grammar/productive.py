@@ -23,7 +23,9 @@ _CYCLE_SHOWN = 6  # rules of a cycle named in the message
 
 
 def unproductive_cycles(grammar) -> list[Diagnostic]:
-    """One warning per cycle of rules from which no derivation can reach a terminal."""
+    """One warning per cycle of rules from which no derivation can reach a terminal; each rule
+    of such a cycle is put in ``grammar.barren``, with the cycle (the engine stops a derivation
+    that hands them too many shapes)."""
     rules: dict[str, n.Rule] = grammar.rules
     deps: dict[str, list[str]] = {}
     productive: set[str] = set()
@@ -49,14 +51,15 @@ def unproductive_cycles(grammar) -> list[Diagnostic]:
     for component in _cycles(barren):
         first = min(component, key=lambda r: (rules[r].pos.line, rules[r].pos.column))
         cycle = _cycle_from(first, component, barren)
-        out.append(_warning(grammar, first, component, cycle, barren))
+        shown = cycle if len(cycle) <= _CYCLE_SHOWN else cycle[:_CYCLE_SHOWN] + ["..."]
+        chain = " -> ".join(shown + [first])
+        grammar.barren.update(dict.fromkeys(component, chain))
+        out.append(_warning(grammar, first, component, chain, barren))
     return sorted(out, key=lambda d: (d.line, d.column))
 
 
-def _warning(grammar, first: str, component: list[str], cycle: list[str], barren) -> Diagnostic:
+def _warning(grammar, first: str, component: list[str], chain: str, barren) -> Diagnostic:
     rule = grammar.rules[first]
-    shown = cycle if len(cycle) <= _CYCLE_SHOWN else cycle[:_CYCLE_SHOWN] + ["..."]
-    chain = " -> ".join(shown + [first])
     names = sorted(component)
     listed = ", ".join(repr(r) for r in names[:_CYCLE_SHOWN])
     if len(names) > _CYCLE_SHOWN:
