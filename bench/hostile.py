@@ -25,7 +25,10 @@ GRID_CITY = ROOT.parent / "shared/bench/grid_city.bgr"
 CAP = 2 * 2**30
 
 RUNAWAYS = {
+    # in rules that can never end in a terminal: stopped after 20,000 shapes handed to them
     "binary split explosion": ("Lot --> A\nA --> split(x) { ~1: A | ~1: A }", []),
+    # one that makes a terminal at every step has to make the whole shape budget
+    "binary explosion with terminals": ("Lot --> A\nA --> split(x) { ~1: A | ~1: A T }", []),
     "1 mm repeat on 10 km": ("Lot --> split(x) { 0.001: T }*", ["--lot", "10000,10"]),
     "floating 1 mm repeat on 10 km": ("Lot --> split(x) { ~0.001: T }*", ["--lot", "10000,10"]),
     "1 cm repeat on 30 km": ("Lot --> split(x) { 0.01: T }*", ["--lot", "30000,10"]),

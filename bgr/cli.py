@@ -540,18 +540,18 @@ def _read(name: str) -> tuple[str, str]:
 def cmd_check(args) -> int:
     status = EXIT_OK
     for name in args.files:
+        shown = "<stdin>" if name == "-" else name
         try:
-            if name == "-":
-                text, _ = _read(name)
-                load(text, path="<stdin>", allow_paths=args.allow_path)
-            else:
-                load(Path(name), path=name, allow_paths=args.allow_path)
+            source = _read(name)[0] if name == "-" else Path(name)
+            grammar = load(source, path=shown, allow_paths=args.allow_path)
         except BgrError as e:
             print(e.render(), file=sys.stderr)
             status = EXIT_INPUT
             continue
+        print(*(w.render() + "\n" for w in grammar.warnings), sep="", end="", file=sys.stderr)
+        count = len(grammar.warnings)  # the file checks: warnings leave the status at 0
         if not args.quiet:
-            print(f"{'<stdin>' if name == '-' else name}: ok")
+            print(f"{shown}: ok" + (f" ({count} warning{'s' * (count > 1)})" if count else ""))
     return status
 
 
@@ -645,7 +645,7 @@ def cmd_derive(args) -> int:
 
     from .formats.sinks import open_sink, streams
     from .interpreter.batch import default_workers, derive_lots
-    from .interpreter.derive import prepare, site_of
+    from .interpreter.derive import FeatureOrder, prepare, site_of
     from .interpreter.lots import check_mapping
 
     if args.output in (None, "-") and args.format != "json":
@@ -688,15 +688,14 @@ def cmd_derive(args) -> int:
     )
     shown: set[tuple] = set()
 
-    def show(items, bar=None) -> None:
+    def show(items, bar) -> None:
         """Each warning once, above the progress bar."""
         for d in items:
-            key = (d.path, d.line, d.column, d.message)
-            if key not in shown:
+            if (key := (d.path, d.line, d.column, d.message)) not in shown:
                 shown.add(key)
-                (bar.write if bar is not None else print)(d.render(), file=sys.stderr)
+                bar.write(d.render(), file=sys.stderr)
 
-    show(warnings.items)
+    read = FeatureOrder(warnings)  # the lot file's warnings, among the lots' in feature order
     with (
         open_sink(
             output,
@@ -711,9 +710,10 @@ def cmd_derive(args) -> int:
         _progress(len(lots), output) as bar,
     ):
         for result in derive_lots(job, lots, workers=workers, dask=args.dask):
-            show(result.warnings, bar)
+            show(read.before(lots[result.index]) + result.warnings, bar)
             sink.add(result.table)
             bar.update()
+        show(read.before(None), bar)
     if output != "-":
         several = f" on {len(lots):,} lots" if len(lots) > 1 else ""
         print(

@@ -57,11 +57,10 @@ _RESERVED_ALIASES = {"scope", "split", "comp", "stdlib", "geometry"}
 
 @dataclass
 class Grammar:
-    """A checked module: its tree, its symbol tables and its imported modules.
+    """A checked module: its tree, its symbol tables, its imported modules and its warnings.
 
     Names are resolved per module: a rule of an imported module refers to that module's own
-    rules, attrs and functions; the importer reaches them as ``alias.Name``.
-    """
+    rules, attrs and functions; the importer reaches them as ``alias.Name``."""
 
     path: str
     module: n.Module
@@ -80,6 +79,8 @@ class Grammar:
     # levels of each func's body, the bodies of the funcs it calls included (grammar.limits)
     func_depths: dict[str, int] = field(default_factory=dict)
     recursive_funcs: set[str] = field(default_factory=set)  # funcs that call themselves
+    warnings: list[Diagnostic] = field(default_factory=list)  # bgr.load: its own and its imports'
+    barren: dict[str, str] = field(default_factory=dict)  # rule -> its cycle (.productive)
 
     def lookup_module(self, dotted: str) -> tuple[Grammar, str]:
         """Split ``alias.Name`` into (module, member); a plain name is this module's own."""
@@ -241,11 +242,10 @@ class Checker:
     def unique_params(self, item: n.Rule | n.Func, what: str) -> None:
         seen = set()
         for i, p in enumerate(item.params):
+            pos = item.param_pos[i] if i < len(item.param_pos) else item.pos
             if p in KEYWORDS:
-                pos = item.param_pos[i] if i < len(item.param_pos) else item.pos
                 self.error(pos, f"'{p}' is a keyword and cannot name a parameter", length=len(p))
             if p in seen:
-                pos = item.param_pos[i] if i < len(item.param_pos) else item.pos
                 self.error(pos, f"parameter '{p}' appears twice in this {what}", length=len(p))
             seen.add(p)
         if isinstance(item, n.Rule):

@@ -94,24 +94,55 @@ class Warnings:
     def __init__(self, strict: bool = False) -> None:
         self.strict = strict
         self.items: list[Diagnostic] = []
+        self.features: list[int | None] = []  # per item: the lot file's feature it is about
         self._seen: set[tuple] = set()
 
-    def warn(self, diagnostic: Diagnostic, error: type[BgrError] | None = None) -> None:
+    def warn(
+        self,
+        diagnostic: Diagnostic,
+        error: type[BgrError] | None = None,
+        feature: int | None = None,
+    ) -> None:
         """Keep ``diagnostic`` as a warning, or raise it (as ``error``, default BgrError) when
         strict."""
         if self.strict:
             raise (error or BgrError)(replace(diagnostic, severity="error"))
-        self.add(diagnostic)
+        self.add(diagnostic, feature)
 
-    def add(self, diagnostic: Diagnostic) -> None:
+    def add(self, diagnostic: Diagnostic, feature: int | None = None) -> None:
         """Keep a warning (once), whatever ``strict`` says."""
         key = (diagnostic.path, diagnostic.line, diagnostic.column, diagnostic.message)
         if key not in self._seen:
             self._seen.add(key)
             self.items.append(replace(diagnostic, severity="warning", hint=None, source_line=None))
+            self.features.append(feature)
 
     def __len__(self) -> int:
         return len(self.items)
+
+
+class HeldWarnings:
+    """Warnings held back while a file is read in several passes (a GeoJSON file's features are
+    parsed, then projected and cleaned together), then passed on sorted by the feature they are
+    about, so that they come in the file's order whatever the pass that found them."""
+
+    def __init__(self, target: Warnings, feature: int = -1, pending: list | None = None) -> None:
+        self.target, self.feature = target, feature
+        self.pending: list = pending if pending is not None else []
+
+    def at(self, feature: int) -> HeldWarnings:
+        """The same store, for warnings about one feature."""
+        return HeldWarnings(self.target, feature, self.pending)
+
+    def warn(self, diagnostic: Diagnostic, error: type[BgrError] | None = None) -> None:
+        self.pending.append((self.feature, len(self.pending), diagnostic, error))
+
+    def flush(self) -> None:
+        """Pass the warnings on in feature order (the first raised, when strict)."""
+        pending = sorted(self.pending, key=lambda p: p[:2])
+        self.pending.clear()
+        for feature, _, diagnostic, error in pending:
+            self.target.warn(diagnostic, error, None if feature < 0 else feature)
 
 
 class BgrSyntaxError(BgrError):

@@ -16,6 +16,7 @@ from .checker import Checker, Grammar
 from .errors import BgrCheckError, BgrError, BgrSyntaxError, Diagnostic, source_line, suggest
 from .parser import parse
 from .paths import ALLOW_HINT, check_input, read_input, roots_of, within
+from .productive import unproductive_cycles
 
 STDLIB_DIR = Path(__file__).resolve().parent.parent / "stdlib"
 
@@ -248,6 +249,9 @@ def load(
         )
         raise (BgrSyntaxError if grammar is None else BgrCheckError)(ordered)
     assert grammar is not None
+    # warnings: each file's own (an import's once, in the order the files were loaded)
+    for module in [*loader.done.values(), grammar]:
+        grammar.warnings += unproductive_cycles(module)
     return grammar
 
 

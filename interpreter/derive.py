@@ -34,7 +34,8 @@ class Result:
     seed: int
     attrs: dict
     # what the run worked around: footprints skipped or repaired, properties ignored, roofs
-    # built as another kind; one-line diagnostics (``d.render()``), in the order they happened
+    # built as another kind; one-line diagnostics (``d.render()``), in the lot file's feature
+    # order (interpreter.derive.FeatureOrder), each once
     warnings: list[Diagnostic] = field(default_factory=list)
 
     def __len__(self) -> int:
@@ -110,12 +111,12 @@ def derive(
         allow_paths=allow_paths,
         lot_options=lot_options,
     )
-    parts = []
+    parts, read, shown = [], FeatureOrder(warnings), []
     for result in derive_lots(job, lots):
-        warnings.items.extend(result.warnings)
+        shown += read.before(lots[result.index]) + result.warnings
         parts.append(result.table)
     table = concat(parts, site=site_of(lots), grammar=str(job.grammar.path or ""))
-    return Result(table, seed, job.values, _once(warnings.items))
+    return Result(table, seed, job.values, _once(shown + read.before(None)))
 
 
 def prepare(
@@ -164,6 +165,28 @@ def prepare(
         per_lot=per_lot,
     )
     return job, lots, warnings
+
+
+class FeatureOrder:
+    """The warnings of reading the lots, handed out among the lots' own in feature order: before
+    a lot, those about its feature and the features before it (one skipped between two lots
+    comes between them; one about no feature, a street file's, first); the rest at the end."""
+
+    def __init__(self, warnings: Warnings) -> None:
+        self.items = list(zip(warnings.features, warnings.items, strict=True))
+        self.at = 0
+
+    def before(self, lot: Lot | None) -> list[Diagnostic]:
+        """The warnings to give before ``lot``'s own; with None, all that are left."""
+        last = None if lot is None else lot.feature
+        out = []
+        while self.at < len(self.items):
+            feature, diagnostic = self.items[self.at]
+            if last is not None and feature is not None and feature > last:
+                break
+            out.append(diagnostic)
+            self.at += 1
+        return out
 
 
 def _once(items: list[Diagnostic]) -> list[Diagnostic]:

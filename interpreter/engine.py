@@ -26,6 +26,7 @@ from bgr.grammar.registry import (
     ROOF_KIND,
 )
 
+from .barren import handed
 from .expressions import Compiler, Context, RuleRef, evaluate_values, runtime_error
 from .geometry import meshes
 from .geometry.polygons import RECT
@@ -106,6 +107,7 @@ class Engine:
         self.attrs = self._prepare_values(grammar, dict(attrs or {}))
         self.table = TerminalTable()
         self.shapes = 0
+        self.barren_shapes = 0  # handed to rules that can never end in a terminal (.barren)
         self._bindings: dict = {}
         self._exprs: dict[int, object] = {}
         self._flat_ids: dict[tuple, int] = {}
@@ -435,9 +437,7 @@ class Application:
                 # the last step may hand the shape itself over: nothing uses it afterwards
                 self.successor(shape, step, handover=step is last)
                 consumed = True
-            elif isinstance(
-                step, n.Nil
-            ):  # the shape is deleted: later steps have nothing to work on
+            elif isinstance(step, n.Nil):  # the shape is deleted: later steps have nothing
                 self.ctx.shape = shape
                 return True
             elif isinstance(step, n.Push):
@@ -519,6 +519,8 @@ class Application:
                 found = (module, member, _name_hash(member), _rule_of(module, member))
                 engine.targets[id(step)] = found
         module, member, member_hash, rule = found
+        if member in module.barren:  # a rule that can never end in a terminal
+            handed(engine, self.module, step, module.barren[member])
         args = self.bind(module, member, step) if step.args else {}
         child = shape if handover else shape.copy()
         index = self.counter
@@ -560,13 +562,9 @@ class Application:
         """The (module, rule name) a parameter used as a successor holds."""
         ref = self.ctx.args[step.name]
         if not isinstance(ref, RuleRef):
-            shown = (
-                f'the string "{ref}"'
-                if isinstance(ref, str)
-                else f"the value {ref:g}"
-                if isinstance(ref, float)
-                else repr(ref)
-            )
+            shown = repr(ref)
+            if isinstance(ref, (str, float)):
+                shown = f'the string "{ref}"' if isinstance(ref, str) else f"the value {ref:g}"
             raise runtime_error(
                 self.module,
                 step.pos,

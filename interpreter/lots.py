@@ -24,7 +24,7 @@ import shapely
 from shapely.geometry import Polygon
 from shapely.validation import make_valid
 
-from bgr.grammar.errors import BgrError, Diagnostic, Warnings, read_json
+from bgr.grammar.errors import BgrError, Diagnostic, HeldWarnings, Warnings, read_json
 
 from .geometry.earclip import signed_area as ring_area
 from .geometry.polygons import RECT, is_unit_square, normalise, signed_area
@@ -46,6 +46,7 @@ class Lot:
     name: str = ""  # how messages name it, e.g. "feature 12 (id 4253124)"; "" for --lot W,D
     source: str = ""  # the file it came from, where property warnings point
     feature_id: str | None = None  # the GeoJSON feature's id (or "id" property), as a string
+    feature: int | None = None  # its feature's index in the file: warnings come in that order
     # where its local metres are on Earth, for lots of a file with a known CRS (see _project):
     # {"crs": "EPSG:32635", "origin": [easting, northing, height]}; None for plain metres
     site: dict | None = None
@@ -322,20 +323,14 @@ def read_geojson(
     crs = _legacy_crs(data, shown, "lot file")
 
     skipped: list[str] = []  # why, for the error when no feature is usable
+    held = HeldWarnings(warnings)  # the two passes below report in feature order
 
-    def skip(name: str, why: str) -> None:
+    def skip(i: int, name: str, why: str) -> None:
         skipped.append(f"{name} skipped: {why}")
-        warnings.warn(
-            Diagnostic(
-                shown,
-                0,
-                0,
-                f"{name} skipped: {why}",
-                "without --strict it is skipped with a warning",
-            )
-        )
+        hint = "without --strict it is skipped with a warning"
+        held.at(i).warn(Diagnostic(shown, 0, 0, f"{name} skipped: {why}", hint))
 
-    items = []  # (name, [outer, *holes] as (k, 2) arrays, properties, id, feature's name)
+    items = []  # (name, [outer, *holes] as (k, 2) arrays, properties, id, feature's name, index)
     polygons = geometries = 0  # features with a Polygon or MultiPolygon geometry, with any
     for i, feature in enumerate(features):
         feature = feature if isinstance(feature, dict) else {}
@@ -349,15 +344,15 @@ def read_geojson(
         try:
             parts = _polygons(feature)
         except FootprintError as e:
-            skip(name, str(e))
+            skip(i, name, str(e))
             continue
         for part, rings in enumerate(parts):
             part_name = f"{name}, part {part}" if len(parts) > 1 else name
             part_id = f"{ident}-{part}" if ident is not None and len(parts) > 1 else ident
             if isinstance(rings, FootprintError):
-                skip(part_name, str(rings))
+                skip(i, part_name, str(rings))
             else:
-                items.append((part_name, rings, properties, part_id, name))
+                items.append((part_name, rings, properties, part_id, name, i))
 
     projected, site, to_local = _project(items, crs)
     streets = None
@@ -365,31 +360,32 @@ def read_geojson(
         streets = read_streets(Path(str(options.streets)), to_local, crs, site, warnings)
     lots = []
     mapped: dict[str, dict] = {}  # feature name -> its mapped attrs (a MultiPolygon's parts share)
-    for name, rings, properties, ident, whose in projected:
+    for name, rings, properties, ident, whose, i in projected:
         if isinstance(rings[0], FootprintError):
-            skip(name, str(rings[0]))
+            skip(i, name, str(rings[0]))
             continue
         try:
             outline, note = clean_ring(rings[0])
         except FootprintError as e:
-            skip(name, str(e))
+            skip(i, name, str(e))
             continue
         if note:
-            warnings.warn(
-                Diagnostic(shown, 0, 0, f"{name}: {note}", "without --strict it is repaired")
-            )
-        holes = _clean_holes(outline, rings[1:], name, shown, warnings)
+            repaired = Diagnostic(shown, 0, 0, f"{name}: {note}", "without --strict it is repaired")
+            held.at(i).warn(repaired)
+        holes = _clean_holes(outline, rings[1:], name, shown, held.at(i))
         front = front_edge(outline, options.front, streets)
         outline = np.roll(outline, -front, axis=0)
         lot = footprint([tuple(p) for p in outline], properties, name, holes)
         lot.source = shown
-        lot.feature_id = ident
-        lot.site = site
+        lot.feature_id, lot.feature, lot.site = ident, i, site
         if options.mapping:
             if whose not in mapped:
-                mapped[whose] = map_properties(properties, options.mapping, whose, shown, warnings)
+                mapped[whose] = map_properties(
+                    properties, options.mapping, whose, shown, held.at(i)
+                )
             lot.mapped = dict(mapped[whose])
         lots.append(lot)
+    held.flush()
     if not lots:
         hint = None
         if not features:
@@ -685,7 +681,7 @@ def read_streets(path: Path, to_local: Callable, crs, site: dict | None, warning
 
 
 def map_properties(
-    properties: dict, mapping: tuple, name: str, shown: str, warnings: Warnings
+    properties: dict, mapping: tuple, name: str, shown: str, warnings: Warnings | HeldWarnings
 ) -> dict:
     """The attrs ``mapping`` (PropertyMap items) gives a feature of ``properties``: each value
     coerced (:func:`coerce`); a property that is missing or null gives nothing, silently; one

@@ -57,10 +57,23 @@ REPRODUCERS = {
         "1,000 shapes",
     ),
     "repeat_default": ("Lot --> split(x) { 0.001: T }*", "--lot 10000,10", "10,000,000 pieces"),
+    # a split explosion in rules that can never end in a terminal stops long before the budget
+    # (issue 24: 3.5 M shapes took 8 to 20 s)
     "binary": (
         "Lot --> A\nA --> split(x) { ~1: A | ~1: A }",
-        "--max-shapes 300000",
-        "more than 300,000 shapes",
+        "",
+        "handed more than 20,000 shapes to rules that can never end in a terminal (A -> A)",
+    ),
+    "binary_self": (
+        "Lot --> split(x) { ~1: Lot | ~1: Lot }",
+        "",
+        "handed more than 20,000 shapes to rules that can never end in a terminal (Lot -> Lot)",
+    ),
+    # one that makes terminals as it explodes still runs into the budget
+    "binary_terminals": (
+        "Lot --> A\nA --> split(x) { ~1: A | ~1: A T }",
+        "--max-shapes 100000",
+        "more than 100,000 shapes",
     ),
     "memory": (
         "Lot --> split(x) { 0.01: T }*",
@@ -105,6 +118,44 @@ def test_reproducer_is_one_located_error_fast_and_small(tmp_path, case):
     assert seconds < SECONDS, f"{case} took {seconds:.1f} s"
     assert not out.exists()
     assert [p.name for p in tmp_path.iterdir()] == [f"{case}.bgr"]  # no temporaries left
+
+
+def test_shapes_given_up_on_in_acyclic_rules_are_not_limited():
+    """Rules that make nothing but end (Hidden --> NIL) may take any number of shapes, and a
+    cycle that cannot emit may run while it stays under the limit."""
+    grammar = "terminal T\nLot --> split(x) { 0.01: Hidden | 0.01: T }*\nHidden --> NIL\n"
+    assert len(bgr.derive(grammar, lot=(2400, 1))) == 120_000
+    ending = (
+        "terminal T\nLot --> T A\nA --> case scope.sx > 1: split(x) { ~1: A | ~1: A } | else: NIL"
+    )
+    assert len(bgr.derive(ending, lot=(8000, 1))) == 1  # 16,383 shapes handed to A
+
+
+def test_explosion_through_extrude_and_comp_stops_at_the_barren_limit(monkeypatch):
+    from bgr.interpreter import barren
+
+    monkeypatch.setattr(barren, "BARREN_SHAPES", 2000)  # the same stop, sooner
+    grammar = (
+        "Lot --> A\nA --> split(x) { ~1: extrude(1) comp(f) { top: B } | ~1: A }\n"
+        "B --> split(y) { ~1: A | ~1: A }\n"
+    )
+    with pytest.raises(bgr.BgrError) as e:
+        bgr.derive(bgr.load(grammar, path="comp.bgr"))
+    assert e.value.message == (
+        "the derivation handed more than 2,000 shapes to rules that can never end in a terminal "
+        "(A -> B -> A)"
+    )
+    assert e.value.path == "comp.bgr" and e.value.line in (2, 3) and "bgr check" in e.value.hint
+
+
+def test_barren_limit_grows_with_the_budget():
+    from bgr.interpreter.barren import BARREN_SHAPES, barren_limit
+    from bgr.interpreter.limits import DEFAULT_MAX_SHAPES
+
+    assert barren_limit(1000) == barren_limit(DEFAULT_MAX_SHAPES) == BARREN_SHAPES
+    assert barren_limit(DEFAULT_MAX_SHAPES * 4) == BARREN_SHAPES * 4
+    with pytest.raises(bgr.BgrError, match="handed more than 40,000 shapes"):
+        bgr.derive("Lot --> split(x) { ~1: Lot | ~1: Lot }", max_shapes=DEFAULT_MAX_SHAPES * 2)
 
 
 def test_degenerate_prism_has_top_and_bottom_only():
