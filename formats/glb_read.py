@@ -12,9 +12,12 @@ import base64
 import json
 import struct
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
-import trimesh
+
+if TYPE_CHECKING:  # imported where used: it costs a second of every command's start
+    import trimesh
 
 from bgr.grammar.errors import BgrError
 from bgr.grammar.paths import read_input
@@ -122,6 +125,8 @@ def world_mesh(
     ``parent`` (the 4x4 world matrix of their parent; identity for a scene's roots), with
     per-face sRGB colours.  Callers that want one mesh per subtree (one per building) call it
     once per subtree."""
+    import trimesh
+
     nodes, meshes, materials = (
         gltf.get("nodes", []),
         gltf.get("meshes", []),

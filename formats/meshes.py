@@ -10,9 +10,12 @@ iterations is the number of distinct mesh shapes, not the number of terminals.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
-import trimesh
+
+if TYPE_CHECKING:  # trimesh is imported where it is used: it costs a second at start-up
+    import trimesh
 
 from bgr.interpreter.terminals import TerminalTable
 
@@ -276,6 +279,8 @@ def to_trimesh(table: TerminalTable) -> trimesh.Trimesh:
 
     ``mesh.metadata["terminal"]`` holds, per face, the index of the terminal it came from.
     """
+    import trimesh  # here, not at the top: importing it costs a second of every command's start
+
     table.freeze()
     baked = bake(table)
     face_row = np.repeat(np.arange(len(table)), np.diff(baked.fstart))
