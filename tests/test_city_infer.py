@@ -164,7 +164,15 @@ def test_editing_one_type_changes_every_instance_of_it_and_nothing_else(tmp_path
 # ---- real cities: level 0 is lossless ---------------------------------------------------------
 
 
-@pytest.mark.parametrize("name", ["delft.obj", "zurich_lod2.obj", "zurich_lod2.city.json"])
+# delft.obj (2,000+ buildings) is the long one: `pytest -m slow`
+@pytest.mark.parametrize(
+    "name",
+    [
+        pytest.param("delft.obj", marks=pytest.mark.slow),
+        "zurich_lod2.obj",
+        "zurich_lod2.city.json",
+    ],
+)
 def test_level_0_of_a_real_city_derives_back_within_a_millimetre(tmp_path, name):
     source = CITIES / name
     if not source.is_file():

@@ -82,13 +82,21 @@ def _assert_mesh(result, what: str) -> None:
 WALLS = {"facade": [(5, 4), (14, 11), (32, 30)], "window": [(0.6, 0.9), (1.2, 1.6), (2.5, 3.2)]}
 
 
+@pytest.mark.parametrize(
+    "seeds_on_largest",
+    [pytest.param([0], id="some"), pytest.param(list(SEEDS), id="all", marks=pytest.mark.slow)],
+)
 @pytest.mark.parametrize("mod", ["facade", "window"])
-def test_every_facade_and_window_derives_on_three_sizes_and_five_seeds(modules, mod):
+def test_every_facade_and_window_derives_on_three_sizes_and_five_seeds(
+    modules, mod, seeds_on_largest
+):
+    """Five seeds on the two smaller walls; on the largest one seed in the default run, five
+    with `pytest -m slow`."""
     names = public(modules[mod])
     grammar = _wrapper(mod, names)
     for name in names:
         for w, h in WALLS[mod]:
-            for seed in SEEDS:
+            for seed in seeds_on_largest if (w, h) == WALLS[mod][-1] else SEEDS:
                 result = bgr.derive(grammar, seed=seed, attrs={"W": w, "H": h}, start=f"T_{name}")
                 _assert_mesh(result, f"{mod}.{name} on {w} x {h} m, seed {seed}")
 
@@ -101,12 +109,23 @@ def _chunks(names: list[str], size: int) -> list[list[str]]:
 MASS_CHUNKS = _chunks(public(module("mass")), 5)
 
 
+# the default run derives each mass with five seeds on the middle lot and one on the others;
+# `pytest -m slow` every seed on every lot
+SWEEPS = [
+    pytest.param({(8, 6): [0], (20, 15): list(SEEDS), (45, 30): [0]}, id="some"),
+    pytest.param(
+        {lot: list(SEEDS) for lot in [(8, 6), (20, 15), (45, 30)]}, id="all", marks=pytest.mark.slow
+    ),
+]
+
+
+@pytest.mark.parametrize("sweep", SWEEPS)
 @pytest.mark.parametrize("names", MASS_CHUNKS, ids=[c[0] for c in MASS_CHUNKS])
-def test_every_mass_derives_on_three_lots_and_five_seeds(modules, names):
+def test_every_mass_derives_on_three_lots_and_five_seeds(modules, names, sweep):
     grammar = modules["mass"]
     for name in names:
-        for lot in [(8, 6), (20, 15), (45, 30)]:
-            for seed in SEEDS:
+        for lot, seeds in sweep.items():
+            for seed in seeds:
                 result = bgr.derive(grammar, seed=seed, lot=lot, start=name)
                 _assert_mesh(result, f"mass.{name} on a {lot} lot, seed {seed}")
                 lo, hi = result.mesh.bounds
