@@ -23,7 +23,7 @@ from __future__ import annotations
 import contextlib
 import math
 import os
-from collections.abc import Iterable
+from collections.abc import Iterable, Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -205,17 +205,12 @@ def _glb_materials(gltf: dict) -> tuple[list[str], np.ndarray]:
     return names, (np.concatenate(out) if out else np.zeros(0, dtype=np.int64))
 
 
-def from_gltf(path: str | os.PathLike) -> Scene:
-    """A .glb or .gltf file, instances expanded (``read_glb``); parts and labels by material."""
-    from ..formats.glb_read import parse, read_glb
-    from ..grammar.paths import read_input
-
-    shown = str(path)
+@contextlib.contextmanager
+def _model_errors(shown: str, what: str, hint: str, caught: tuple = (Exception,)) -> Iterator[None]:
+    """Every failure reading the model file ``shown`` as one located BgrError: a missing or
+    unreadable file, or one the reader cannot parse (``caught``: what it raises on bad input)."""
     try:
-        data = read_input(path, "model file")
-        gltf, _ = parse(data)
-        mesh = read_glb(path)
-        names, material = _glb_materials(gltf)
+        yield
     except FileNotFoundError:
         raise BgrError(Diagnostic(shown, 0, 0, "no such file", "check the path")) from None
     except BgrError as exc:
@@ -224,16 +219,27 @@ def from_gltf(path: str | os.PathLike) -> Scene:
         raise BgrError(
             Diagnostic(shown, 0, 0, f"cannot read the file: {exc.strerror or exc}")
         ) from None
-    except (ValueError, KeyError, IndexError, TypeError, AttributeError, StopIteration) as exc:
-        raise BgrError(
-            Diagnostic(
-                shown,
-                0,
-                0,
-                f"not a glTF 2.0 file bgr can read ({type(exc).__name__}: {exc})",
-                "bgr reads triangle meshes with float positions",
-            )
-        ) from None
+    except caught as exc:
+        message = f"not {what} bgr can read ({type(exc).__name__}: {exc})"[:300]
+        raise BgrError(Diagnostic(shown, 0, 0, message, hint)) from None
+
+
+def from_gltf(path: str | os.PathLike) -> Scene:
+    """A .glb or .gltf file, instances expanded (``read_glb``); parts and labels by material."""
+    from ..formats.glb_read import parse, read_glb
+    from ..grammar.paths import read_input
+
+    shown = str(path)
+    with _model_errors(
+        shown,
+        "a glTF 2.0 file",
+        "bgr reads triangle meshes with float positions",
+        (ValueError, KeyError, IndexError, TypeError, AttributeError, StopIteration),
+    ):
+        data = read_input(path, "model file")
+        gltf, _ = parse(data)
+        mesh = read_glb(path)
+        names, material = _glb_materials(gltf)
     return from_trimesh(mesh, names, material)
 
 
@@ -306,44 +312,26 @@ def from_mesh_file(path: str | os.PathLike) -> Scene:
     quiet = logging.getLogger("trimesh")
     level = quiet.level
     try:
-        data = read_input(path, "model file")
-        libraries, warnings = _mtl_libraries(path, data) if fmt == "obj" else ({}, [])
-        stream: io.IOBase = io.BytesIO(data)
-        if fmt == "obj":  # a text file: bytes that are not text are no OBJ
-            if b"\0" in data:
-                raise BgrError(
-                    Diagnostic(
-                        shown,
-                        0,
-                        0,
-                        "a binary file, not a Wavefront OBJ (a text file)",
-                        "bgr renders .bgr, .glb, .gltf, .obj (text, with its .mtl) and .ply files",
-                    )
-                )
-            stream = io.StringIO(data.decode("utf-8", "replace"))
-        quiet.setLevel(logging.CRITICAL)  # a missing material is said once, by the warning above
-        loaded = trimesh.load(
-            stream, file_type=fmt, resolver=libraries, process=False, force="scene"
-        )
-        meshes = [m for m in loaded.dump(concatenate=False) if len(getattr(m, "faces", ()))]
-    except FileNotFoundError:
-        raise BgrError(Diagnostic(shown, 0, 0, "no such file", "check the path")) from None
-    except BgrError as exc:
-        raise BgrError(Diagnostic(shown, 0, 0, exc.message, exc.hint)) from None
-    except OSError as exc:
-        raise BgrError(
-            Diagnostic(shown, 0, 0, f"cannot read the file: {exc.strerror or exc}")
-        ) from None
-    except Exception as exc:  # noqa: BLE001  # trimesh's parsers raise many kinds
-        raise BgrError(
-            Diagnostic(
-                shown,
-                0,
-                0,
-                f"not a .{fmt} file bgr can read ({type(exc).__name__}: {exc})"[:300],
-                "bgr reads triangle meshes (OBJ with its .mtl, PLY with vertex or face colours)",
+        with _model_errors(
+            shown,
+            f"a .{fmt} file",
+            "bgr reads triangle meshes (OBJ with its .mtl, PLY with vertex or face colours)",
+        ):  # trimesh's parsers raise many kinds of exception
+            data = read_input(path, "model file")
+            libraries, warnings = _mtl_libraries(path, data) if fmt == "obj" else ({}, [])
+            stream: io.IOBase = io.BytesIO(data)
+            if fmt == "obj":  # a text file: bytes that are not text are no OBJ
+                if b"\0" in data:
+                    hint = "bgr renders .bgr, .glb, .gltf, .obj (with its .mtl) and .ply files"
+                    message = "a binary file, not a Wavefront OBJ (a text file)"
+                    raise BgrError(Diagnostic(shown, 0, 0, message, hint))
+                stream = io.StringIO(data.decode("utf-8", "replace"))
+            # a missing material is said once, by the warning above
+            quiet.setLevel(logging.CRITICAL)
+            loaded = trimesh.load(
+                stream, file_type=fmt, resolver=libraries, process=False, force="scene"
             )
-        ) from None
+            meshes = [m for m in loaded.dump(concatenate=False) if len(getattr(m, "faces", ()))]
     finally:
         quiet.setLevel(level)
     if not meshes:

@@ -15,6 +15,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 from conftest import ROOT
+from test_boxes import box
 
 from bgr.cli import main
 from bgr.inverse.boxes import model
@@ -32,16 +33,6 @@ COMMANDS = [
     ("regular_facade", (30, 20, 0.5), "xyz"),
     ("building", (36, 19, 14), "xyz"),
 ]
-
-
-def box(id, lo, hi, tags="SSS", children=()) -> dict:
-    return {
-        "id": id,
-        "min": list(lo),
-        "max": list(hi),
-        "behavior": dict(zip("xyz", tags, strict=True)),
-        "children": list(children),
-    }
 
 
 def parse(root: dict) -> model.Box:
