@@ -18,6 +18,7 @@ import traceback
 from pathlib import Path
 
 from . import __version__
+from .formats.atomic import Terminated, on_sigterm, reset_termination
 from .grammar.errors import BgrError, Diagnostic
 from .grammar.formatter import format_module
 from .grammar.loader import decode, load, read_source
@@ -933,7 +934,8 @@ def main(argv: list[str] | None = None) -> int:
     if args.command is None:
         parser.print_help(sys.stderr)
         return EXIT_USAGE
-    previous = _on_sigterm(_terminate)
+    reset_termination()
+    previous = _on_sigterm(on_sigterm)
     try:
         with _address_space_restored():
             return COMMANDS[args.command](args)
@@ -968,15 +970,6 @@ def main(argv: list[str] | None = None) -> int:
     finally:
         if previous is not None:
             _on_sigterm(previous)
-
-
-class Terminated(KeyboardInterrupt):
-    """SIGTERM, raised where the program is, so that it unwinds as for Ctrl-C: the atomic
-    writers remove their temporaries (a ``kill`` leaves no ``.tmp`` beside the output)."""
-
-
-def _terminate(signum, frame) -> None:
-    raise Terminated
 
 
 def _on_sigterm(handler):

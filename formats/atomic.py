@@ -30,6 +30,35 @@ from bgr.grammar.paths import check_output
 UNOWNED_STALE_AFTER = 3600.0
 
 
+class Terminated(KeyboardInterrupt):
+    """SIGTERM, raised where the program is, so that it unwinds as for Ctrl-C: the atomic
+    writers remove their temporaries (a ``kill`` leaves no ``.tmp`` beside the output)."""
+
+
+# set by bgr's SIGTERM handler: a termination that some code swallowed (an exception raised in a
+# __del__, a weakref callback or a generator's close is only printed) is raised again before an
+# output is finished or put in place, rather than lost while the file is completed
+_terminating = False
+
+
+def on_sigterm(signum, frame) -> None:
+    """bgr's SIGTERM handler (installed by ``bgr.cli.main``)."""
+    global _terminating
+    _terminating = True
+    raise Terminated
+
+
+def reset_termination() -> None:
+    global _terminating
+    _terminating = False
+
+
+def raise_if_terminated() -> None:
+    """Raise :class:`Terminated` if a SIGTERM came, even one whose first raise was lost."""
+    if _terminating:
+        raise Terminated
+
+
 def _open_temp(target: Path) -> tuple[Path, BinaryIO]:
     folder = target.parent
     for _ in range(100):
@@ -130,6 +159,7 @@ def atomic_files(targets: list[Path]) -> Iterator[list[BinaryIO]]:
             temps.append(_open_temp(target))
         current = targets[0]
         yield [f for _, f in temps]
+        raise_if_terminated()
         for (tmp, f), target in zip(temps, targets, strict=True):
             current = target
             f.close()

@@ -25,7 +25,7 @@ import numpy as np
 from bgr.interpreter.terminals import TerminalTable, concat
 
 from . import check_writable, format_of, write
-from .atomic import atomic_files
+from .atomic import atomic_files, raise_if_terminated
 from .cityjson import SequenceWriter
 from .glb import Scene
 from .terminal_json import TerminalListWriter
@@ -71,6 +71,7 @@ class _Glb(Sink):
         self.scene.add(table)
 
     def finish(self) -> None:
+        raise_if_terminated()  # assembling the file takes a while: not after a SIGTERM
         self.scene.write_glb(self.stream)
 
 
