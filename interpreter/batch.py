@@ -29,7 +29,7 @@ import os
 import uuid
 from collections import deque
 from collections.abc import Callable, Iterable, Iterator
-from concurrent.futures import Future, ProcessPoolExecutor
+from concurrent.futures import Future
 from dataclasses import dataclass, field, replace
 
 from bgr.grammar.checker import Grammar
@@ -39,6 +39,7 @@ from .engine import Engine
 from .limits import default_max_memory, memory_in_use
 from .lots import Lot, attr_overrides
 from .terminals import TerminalTable
+from .workers import Pool
 
 # the split cache (pure: sizes -> placed pieces) is kept across the lots one process derives,
 # and emptied when it holds more entries than this, so that a long run does not grow with it
@@ -307,13 +308,16 @@ def _context():
 
 
 def _on_pool(job: Job, batches: Iterator[list], workers: int, window: int) -> Iterator[LotResult]:
-    pool = ProcessPoolExecutor(
-        max_workers=workers, mp_context=_context(), initializer=_start_worker, initargs=(job,)
-    )
-    try:
-        yield from _in_order(lambda batch: pool.submit(_pool_batch, batch), batches, window)
-    finally:
-        pool.shutdown(wait=True, cancel_futures=True)
+    pool = Pool(workers, _context(), _start_worker, (job,))
+    for results in pool.ordered(_pool_batch, batches, window, describe=_lots_of):
+        yield from results
+
+
+def _lots_of(batch: list[tuple[int, Lot]]) -> str:
+    """How a dead worker's message names the lots it was deriving."""
+    first, last = batch[0][0], batch[-1][0]
+    name = lot_name(batch[0][1], first, True)
+    return name if first == last else f"lots {first}-{last} (from {name})"
 
 
 def _in_order(
