@@ -273,7 +273,8 @@ def build_parser() -> argparse.ArgumentParser:
         "--assets",
         metavar="DIR",
         help="folder for the component meshes (default: OUT.assets beside -o OUT.bgr, or "
-        "./city.assets when the grammar goes to standard output)",
+        "./city.assets when the grammar goes to standard output); it must be new, empty or one "
+        "bgr wrote (with its .bgr-assets.json), as bgr replaces it whole",
     )
     city.add_argument(
         "--up",

@@ -11,10 +11,11 @@ from typing import Any
 
 import numpy as np
 
+from bgr.formats.atomic import cannot_write
 from bgr.formats.atomic import write_text as write_atomic
 from bgr.grammar.errors import BgrError, Diagnostic
 from bgr.grammar.formatter import format_module
-from bgr.grammar.paths import check_input, roots_of, within
+from bgr.grammar.paths import check_input, check_output, roots_of, within
 
 from .analysis import min_length
 from .emit import ATTRS, write
@@ -240,24 +241,44 @@ def shade(rgb: tuple[float, float, float], box: Box) -> tuple[float, float, floa
 
 def run_infer(args) -> int:
     source = Path(args.input)
-    root = read(source)
     out = None if args.output in (None, "-") else Path(args.output)
+    if out is not None:
+        check_grammar_output(out)
+    root = read(source)
     try:
         written = write(root, str(args.input), source.parent, (out or Path("x")).parent)
+        text = format_module(written.module)
+        # everything is checked before the grammar is written: a failure writes nothing
+        report = compare(root, out or Path.cwd() / "stdout.bgr", source.parent)
     except BgrError as e:
         raise located(e, source) from None
-    text = format_module(written.module)
     if out is None:
         sys.stdout.write(text)
     else:
         write_atomic(out, text)
-    report = compare(root, out or Path.cwd() / "stdout.bgr", source.parent)
     how = "exact" if written.exact else "approximate"
     print(
         f"{args.output or '<stdout>'}: {len(written.module.rules())} rules, {how}; {report}",
         file=sys.stderr,
     )
     return 0
+
+
+def check_grammar_output(out: Path) -> None:
+    """Refuse, before any work, a grammar output that cannot be written (a folder, a device)."""
+    if out.is_dir():
+        raise BgrError(
+            Diagnostic(
+                str(out),
+                0,
+                0,
+                "cannot write the grammar: it is a folder",
+                "name a file for -o, such as boxes.bgr",
+            )
+        )
+    check_output(out)
+    if not out.parent.is_dir():
+        raise cannot_write(out, FileNotFoundError(2, "no such folder"))
 
 
 def compare(root: Box, where: Path, base: Path) -> str:
@@ -278,7 +299,7 @@ def compare(root: Box, where: Path, base: Path) -> str:
     for size in sizes:
         try:
             target = retarget(root, size)
-            derived = derive_boxes(grammar, named.runs, size, root)
+            derived = derive_boxes(grammar, named.runs, size, root, named.ids)
         except BgrError as e:
             return f"not checked against bgr retarget ({e.message})"
         a, t = alignments(root, target)
@@ -293,16 +314,19 @@ def compare(root: Box, where: Path, base: Path) -> str:
     )
 
 
-def derive_boxes(grammar, runs: set[str], size, root: Box) -> Box:
+def derive_boxes(
+    grammar, runs: set[str], size, root: Box, ids: dict[str, str] | None = None
+) -> Box:
     """The boxes a grammar written with ``labels=True`` derives at ``size``, as a flat
-    hierarchy under ``root``'s id: each named by the input box it is, copies (a repeat index
-    above 0 under a run rule) as copies."""
+    hierarchy under ``root``'s id: each named by the input box it is (``ids``: the grammar's
+    labels -> box ids), copies (a repeat index above 0 under a run rule) as copies."""
     import bgr
 
     result = bgr.derive(grammar, attrs=dict(zip(ATTRS, (float(v) for v in size), strict=True)))
     t = result.terminals.freeze()
     out = Box(root.id, root.lo.copy(), root.lo + np.asarray(size, dtype=float), root.tags)
-    for k, (label, path) in enumerate(zip(t.label, t.path, strict=True)):
+    for k, (short, path) in enumerate(zip(t.label, t.path, strict=True)):
+        label = (ids or {}).get(short, short)
         steps = path.split("/")
         copy = any(
             prev.rsplit(".", 1)[0] in runs and not step.endswith(".0")
@@ -316,19 +340,13 @@ def derive_boxes(grammar, runs: set[str], size, root: Box) -> Box:
 
 
 def _loaded(text: str, where: Path, base: Path):
-    """The grammar ``text`` loaded as if it were the file ``where`` (its assets resolve)."""
-    import tempfile
-
+    """The grammar ``text`` loaded as if it were the file ``where`` (its assets resolve), with
+    no file written: the output's folder may not exist yet, and nothing is left there."""
     import bgr
 
-    with tempfile.NamedTemporaryFile(
-        "w", suffix=".bgr", dir=where.parent, delete=False, encoding="utf-8"
-    ) as f:
-        f.write(text)
-    try:
-        return bgr.load(f.name, allow_paths=[str(base)])
-    finally:
-        Path(f.name).unlink()
+    return bgr.load(
+        text.encode("utf-8"), path=str(where.with_name("inferred.bgr")), allow_paths=[str(base)]
+    )
 
 
 def _same_leaves(a: Box, b: Box) -> bool:

@@ -25,9 +25,13 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from bgr.grammar import nodes as n
+from bgr.grammar.errors import BgrError
 from bgr.grammar.registry import BUILTIN_NAMES, KEYWORDS, OPERATIONS
 
 from .analysis import min_length
+from .depth import MAX_DEPTH, deep_message, nesting, rule_depth, too_deep
+from .depth import fills as _fills
+from .depth import shown as _shown
 from .model import AXES, EPS, Box
 
 ATTRS = ("width", "height", "length")  # x, y, z ('depth' is the derivation depth in .bgr)
@@ -53,6 +57,7 @@ class Written:
     exact: bool  # False when some part is approximated
     notes: list[str] = field(default_factory=list)  # what is approximated, for the header
     runs: set[str] = field(default_factory=set)  # the rules that repeat a box
+    ids: dict[str, str] = field(default_factory=dict)  # label -> box id (labels=True)
 
 
 def write(
@@ -64,9 +69,31 @@ def write(
 ) -> Written:
     """The grammar of ``root``; mesh paths (relative to ``base``, the boxes file's folder) are
     written relative to ``out_dir``, where the grammar goes.  ``labels``: a rule per box (no
-    sharing) labelling its terminals with the box's id — the same derivation, with names, which
-    is how ``infer`` tells which derived box is which input box."""
-    return _Writer(root, source, base or Path("."), out_dir or Path("."), labels).module()
+    sharing) labelling its terminals with a short name per box (``Written.ids`` maps each to the
+    box's id, whatever it holds) — the same derivation, with names, which is how ``infer`` tells
+    which derived box is which input box.  A grammar that bgr derive's rule depth limit would
+    stop has its chains of boxes collapsed, or is refused with a :class:`BgrError` (:mod:`.depth`).
+    """
+    args = (root, source, base or Path("."), out_dir or Path("."), labels)
+    problem = too_deep(root)
+    if problem:
+        raise BgrError(problem)
+    written = None
+    try:
+        if nesting(root, collapse=False) <= MAX_DEPTH:  # one rule per box, the usual grammar
+            written = _Writer(*args).module()
+        if written is None or rule_depth(written.module) > MAX_DEPTH:
+            # each chain of boxes filling their parent as one rule, so that it derives
+            written = _Writer(*args, flatten=True).module()
+    except RecursionError:  # slabs within slabs nesting past Python's stack
+        raise BgrError(deep_message(None)) from None
+    depth = rule_depth(written.module)
+    if depth > MAX_DEPTH:
+        raise BgrError(deep_message(depth))
+    return written
+
+
+_NAME_LENGTH = 64  # a rule or asset name from a box id or mesh keeps this many characters
 
 
 def _num(x: float) -> n.Number:
@@ -83,9 +110,19 @@ def _name(s: str) -> n.Name:
 
 
 class _Writer:
-    def __init__(self, root: Box, source: str, base: Path, out_dir: Path, labels: bool) -> None:
+    def __init__(
+        self,
+        root: Box,
+        source: str,
+        base: Path,
+        out_dir: Path,
+        labels: bool,
+        flatten: bool = False,
+    ) -> None:
         self.root = root
         self.labels = labels
+        self.flatten = flatten  # a box whose only child fills it: one rule with the child
+        self.ids: dict[str, str] = {}  # label -> box id (labels=True)
         self.source = source
         self.base = base
         self.out_dir = out_dir
@@ -97,12 +134,14 @@ class _Writer:
         self.runs: dict[tuple[str, int], str] = {}
         self.uses_grow = False
         self.notes: list[str] = []
+        self.keys = self._keys(root)
+        self.collapsed = False  # some chain was written as one rule (flatten)
 
     # ---- names ---------------------------------------------------------------------------
     def fresh(self, base: str) -> str:
         words = [w for w in re.split(r"[^A-Za-z0-9]+", base) if w and not w.isdigit()]
         words = [w.rstrip("0123456789") or w for w in words]
-        name = "".join(w[0].upper() + w[1:] for w in words) or "Part"
+        name = "".join(w[0].upper() + w[1:] for w in words)[:_NAME_LENGTH] or "Part"
         if not name[0].isalpha():
             name = "B" + name
         out, i = name, 2
@@ -113,8 +152,13 @@ class _Writer:
 
     def asset(self, mesh: str) -> str:
         if mesh not in self.assets:
-            path = Path(os.path.relpath((self.base / mesh).resolve(), self.out_dir.resolve()))
-            stem = re.sub(r"[^A-Za-z0-9_]", "_", Path(mesh).stem).strip("_").lower() or "part"
+            try:
+                full = (self.base / mesh).resolve()
+            except OSError as e:  # a name longer than the system takes
+                raise BgrError(f"mesh '{_shown(mesh)}' is not a path: {e.strerror}") from None
+            path = Path(os.path.relpath(full, self.out_dir.resolve()))
+            stem = re.sub(r"[^A-Za-z0-9_]", "_", Path(mesh).stem).strip("_").lower()
+            stem = stem[:_NAME_LENGTH] or "part"
             if not stem[0].isalpha():
                 stem = "m_" + stem
             name, i = stem, 2
@@ -124,15 +168,42 @@ class _Writer:
             self.assets[mesh] = n.Asset(name, path.as_posix())
         return self.assets[mesh].name
 
+    def label(self, box: Box) -> n.Operation:
+        """``label("b12")``: a short name for the box, whatever its id holds (NUL, 100,000
+        characters); :attr:`ids` maps it back."""
+        name = f"b{len(self.ids)}"
+        self.ids[name] = box.id
+        return n.Operation("label", [n.String(name)])
+
     # ---- boxes ---------------------------------------------------------------------------
+    def _keys(self, root: Box) -> dict[int, tuple]:
+        """Every box's key (what makes two boxes the same rule), children first, without
+        recursion: a child's key is held as a number, so keys stay flat however deep."""
+        keys: dict[int, tuple] = {}
+        number: dict[tuple, int] = {}
+        stack: list[tuple[Box, bool]] = [(root, False)]
+        while stack:
+            box, ready = stack.pop()
+            if not ready:
+                stack.append((box, True))
+                stack += [(c, False) for c in box.children]
+                continue
+            key = (
+                box.id if self.labels else "",
+                box.tags,
+                box.mesh,
+                tuple(round(v, 6) for v in box.size),
+                tuple(
+                    (tuple(round(v, 6) for v in c.lo - box.lo), number[keys[id(c)]])
+                    for c in box.children
+                ),
+            )
+            keys[id(box)] = key
+            number.setdefault(key, len(number))
+        return keys
+
     def key(self, box: Box) -> tuple:
-        return (
-            box.id if self.labels else "",
-            box.tags,
-            box.mesh,
-            tuple(round(v, 6) for v in box.size),
-            tuple((tuple(round(v, 6) for v in c.lo - box.lo), self.key(c)) for c in box.children),
-        )
+        return self.keys[id(box)]
 
     def box_rule(self, box: Box) -> str:
         key = self.key(box)
@@ -140,7 +211,13 @@ class _Writer:
             return self.by_key[key]
         name = self.by_key[key] = self.fresh(Path(box.mesh).stem if box.mesh else box.id)
         steps: list[n.Step] = []
-        named = [n.Operation("label", [n.String(box.id)])] if self.labels else []
+        while self.flatten and len(box.children) == 1 and _fills(box.children[0], box.lo, box.hi):
+            if box.mesh:  # the chain's meshes, each on the same scope
+                named = [self.label(box)] if self.labels else []
+                steps.append(n.Push([*named, n.Operation("i", [_name(self.asset(box.mesh))])]))
+            box = box.children[0]
+            self.collapsed = True
+        named = [self.label(box)] if self.labels and (box.mesh or not box.children) else []
         if box.mesh:
             insert = [*named, n.Operation("i", [_name(self.asset(box.mesh))])]
             steps += [n.Push(insert)] if box.children else insert
@@ -313,7 +390,7 @@ class _Writer:
         boxes = sum(1 for _ in root.walk())
         least = " x ".join(f"{min_length(root, a):g}" for a in range(3))
         header = [
-            f"# Inferred by bgr infer --kind boxes from {self.source or 'a box hierarchy'}: "
+            f"# Inferred by bgr infer --kind boxes from {_shown(self.source, 200) or 'boxes'}: "
             f"{boxes} boxes, {len(self.rules) + 1} rules.",
             "# Derive it at another size with --set width=W --set height=H --set length=L (x, y, z",
             "# in metres; y is up). R boxes replicate as bgr retarget replicates them, S boxes",
@@ -322,6 +399,12 @@ class _Writer:
             f"# The fixed boxes need at least {least} m: bgr retarget refuses a smaller size,",
             "# this grammar squeezes them.",
         ]
+        if self.collapsed:
+            header += [
+                "# A box that is its parent's only child and fills it is written in its",
+                "# parent's rule: one rule per box would nest deeper than bgr derive's limit",
+                f"# of {MAX_DEPTH}.",
+            ]
         if self.notes:
             header.append("# Approximated (bgr retarget does better here):")
             header += [f"#   {note}" for note in dict.fromkeys(self.notes)]
@@ -329,7 +412,9 @@ class _Writer:
 
         module = _laid_out(header, [head, funcs + assets + decls, [lot], self.rules])
         notes = list(dict.fromkeys(self.notes))
-        return Written(module, exact=not notes, notes=notes, runs=set(self.runs.values()))
+        return Written(
+            module, exact=not notes, notes=notes, runs=set(self.runs.values()), ids=self.ids
+        )
 
 
 def _grow() -> n.Func:
@@ -344,10 +429,6 @@ def _grow() -> n.Func:
     )
     body = _bin("+", _name("used"), _bin("*", _name("size"), n.Call("max", [_num(-1), copies])))
     return n.Func("grow", ["used", "share", "size"], body)
-
-
-def _fills(box: Box, lo, hi) -> bool:
-    return bool(((abs(box.lo - lo) <= EPS) & (abs(box.hi - hi) <= EPS)).all())
 
 
 def _guillotine(boxes: list[Box], lo, hi) -> tuple[int, list[Slab]] | None:

@@ -24,6 +24,7 @@ AXES = "xyz"
 BEHAVIOURS = ("S", "R", "F")
 EPS = 1e-6  # metres: faces closer than this coincide (the paper's epsilon-precision)
 FORMAT = '{"root": {"id": ..., "min": [x, y, z], "max": [x, y, z], "children": [...]}}'
+MESH_PATH, MESH_NAME = 4096, 255  # a mesh path's characters and a name's bytes (PATH_MAX, NAME_MAX)
 READS = f"a boxes file is a JSON object {FORMAT} (docs/inverse-boxes.md)"
 
 
@@ -59,10 +60,13 @@ class Box:
         return self.hi - self.lo
 
     def walk(self) -> Iterator[Box]:
-        """This box and every descendant, depth first, children in order."""
-        yield self
-        for child in self.children:
-            yield from child.walk()
+        """This box and every descendant, depth first, children in order; a loop, not nested
+        generators, so that a deep hierarchy costs no more per box than a flat one."""
+        stack: list[Box] = [self]
+        while stack:
+            box = stack.pop()
+            yield box
+            stack.extend(reversed(box.children))
 
     def leaves(self) -> Iterator[Box]:
         return (b for b in self.walk() if not b.children)
@@ -249,6 +253,13 @@ def _box(obj, name: str, where: str, ids: dict, fixed: tuple[bool, bool, bool]) 
     mesh = obj.get("mesh")
     if mesh is not None and (not isinstance(mesh, str) or not mesh.strip()):
         raise _fail(name, f'{here}: "mesh" must be a file path')
+    if mesh is not None and _path_problem(mesh):
+        raise _fail(
+            name,
+            f'{here}: "mesh" holds {_path_problem(mesh)}, which no file path has',
+            f"name the part's file relatively to the boxes file, at most {MESH_PATH:,} "
+            f"characters and {MESH_NAME} bytes a name",
+        )
     children = obj.get("children", [])
     if not isinstance(children, list):
         raise _fail(name, f'{here}: "children" must be a list of boxes')
@@ -261,6 +272,18 @@ def _box(obj, name: str, where: str, ids: dict, fixed: tuple[bool, bool, bool]) 
     now = (tags[0] == "F", tags[1] == "F", tags[2] == "F")
     kids = [_box(c, name, f"child {k} of '{box_id}'", ids, now) for k, c in enumerate(children)]
     return Box(box_id, lo, hi, (tags[0], tags[1], tags[2]), mesh, kids, source, replica)
+
+
+def _path_problem(mesh: str) -> str | None:
+    """What makes ``mesh`` no file path the system takes (a NUL, too long), or None."""
+    if "\0" in mesh:
+        return "a NUL character"
+    if len(mesh) > MESH_PATH:
+        return f"{len(mesh):,} characters"
+    longest = max(
+        len(p.encode("utf-8", "surrogatepass")) for p in mesh.replace("\\", "/").split("/")
+    )
+    return f"a name of {longest:,} bytes" if longest > MESH_NAME else None
 
 
 def check(root: Box, eps: float = EPS) -> list[str]:

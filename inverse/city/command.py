@@ -56,6 +56,7 @@ def run(args) -> int:
         assets_dir = output.with_name(stem + ".assets")
     else:
         assets_dir = Path("city.assets")
+    check_outputs(output, assets_dir, Path(args.input))  # before the (slow) inference
     base = output.parent if output is not None else Path(".")
     named = Path(os.path.relpath(assets_dir.resolve(), base.resolve())).as_posix()
     options = Options(
@@ -72,7 +73,7 @@ def run(args) -> int:
     )
     grammar = infer_city(args.input, options)
     text = to_text(grammar)
-    write(grammar, text, output, assets_dir)
+    write(grammar, text, output, assets_dir, keep=(Path(args.input),))
     placed = grammar.placed
     print(
         f"{args.input}: {len(grammar.scene.objects)} objects, {len(grammar.comps)} components, "
@@ -84,6 +85,33 @@ def run(args) -> int:
     if args.stats:
         print(stats_table(level_stats(args.input, grammar, options)), file=sys.stderr)
     return 0
+
+
+def check_outputs(output: Path | None, assets_dir: Path, source: Path) -> None:
+    """Refuse, before any work, outputs the run could not write or would lose data writing:
+    a folder or a device as the grammar, and an assets folder bgr did not write
+    (formats/assets_folder.check_folder)."""
+    from bgr.formats.assets_folder import check_folder
+    from bgr.formats.atomic import cannot_write
+    from bgr.grammar.errors import Diagnostic
+    from bgr.grammar.paths import check_output
+
+    if output is not None:
+        if output.is_dir():
+            raise BgrError(
+                Diagnostic(
+                    str(output),
+                    0,
+                    0,
+                    "cannot write the grammar: it is a folder",
+                    "name a file for -o, such as city.bgr",
+                )
+            )
+        check_output(output)
+        made = assets_dir.resolve().parents  # write() makes the assets folder's parents
+        if not output.parent.is_dir() and output.parent.resolve() not in made:
+            raise cannot_write(output, FileNotFoundError(2, "no such folder"))
+    check_folder(assets_dir, [source, *(() if output is None else (output,))])
 
 
 def stats_table(rows: list[dict]) -> str:

@@ -365,38 +365,32 @@ def to_text(grammar: CityGrammar) -> str:
     return buffer.getvalue()
 
 
-def write(grammar: CityGrammar, text: str, output: Path | None, assets_dir: Path) -> None:
-    """Write the assets folder, then the grammar (``output``; None: standard output).
+def write(
+    grammar: CityGrammar,
+    text: str,
+    output: Path | None,
+    assets_dir: Path,
+    keep: tuple[Path, ...] = (),
+) -> None:
+    """Write the assets folder and the grammar (``output``; None: standard output), all or
+    nothing.
 
-    The folder is written beside its final place and swapped in, so that a failure leaves the
-    old folder (or none) and never half of the new one; the grammar is written last, atomically.
+    The assets go in a fresh folder beside their place, swapped in whole with a manifest of
+    the files bgr wrote (formats/assets_folder.py): a folder bgr did not write is refused, never
+    replaced, and a failure (the grammar's write included) puts the old folder back.  ``keep``:
+    paths the folder must not hold (the input).
     """
-    import os
-    import shutil
-    import tempfile
+    from bgr.formats.assets_folder import assets_written
+    from bgr.formats.atomic import write_text
 
-    assets_dir = Path(assets_dir)
-    assets_dir.parent.mkdir(parents=True, exist_ok=True)
-    staging = Path(tempfile.mkdtemp(prefix=f".{assets_dir.name}-", dir=assets_dir.parent))
-    try:
-        for name, data in grammar.assets.items():
-            (staging / name).write_bytes(data)
-        old = None
-        if assets_dir.exists():
-            old = assets_dir.with_name(f".{assets_dir.name}-old-{os.getpid()}")
-            os.replace(assets_dir, old)
-        os.replace(staging, assets_dir)
-        if old is not None:
-            shutil.rmtree(old, ignore_errors=True)
-    except BaseException:
-        shutil.rmtree(staging, ignore_errors=True)
-        raise
-    if output is None:
-        sys.stdout.write(text)
-    else:
-        from bgr.cli import write_atomic
-
-        write_atomic(Path(output), text)
+    keep = (*keep, *(() if output is None else (Path(output),)))
+    with assets_written(
+        Path(assets_dir), grammar.assets, keep=keep, written_by="bgr infer --kind city"
+    ):
+        if output is None:
+            sys.stdout.write(text)
+        else:
+            write_text(Path(output), text)
 
 
 def rebuilt(placed: Placed) -> tuple[np.ndarray, np.ndarray]:

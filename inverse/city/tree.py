@@ -134,6 +134,8 @@ def kind_graph(
     a, b = kinds[pairs[:, 0]], kinds[pairs[:, 1]]
     keep = a != b
     pairs, a, b = pairs[keep], a[keep], b[keep]
+    if len(pairs) == 0:  # every neighbour is of its own kind (a street of one house)
+        return graph
     lo, hi = np.minimum(a, b), np.maximum(a, b)
     delta = midpoints[pairs[:, 0]] - midpoints[pairs[:, 1]]
     dist = np.linalg.norm(delta, axis=1)  # equation 2
