@@ -330,3 +330,13 @@ def test_stale_rule(tmp_path):
     assert not is_stale(tmp_path / f".out.glb.{os.getpid()}.ab.tmp", "out.glb")
     assert is_stale(tmp_path / f".out.glb.{dead_pid()}.ab.tmp", "out.glb")
     assert not is_stale(tmp_path / f".x.glb.{dead_pid()}.ab.tmp", "out.glb")
+
+
+def test_an_asset_name_the_system_refuses_is_a_located_error(tmp_path):
+    """A 300-character file name (ENAMETOOLONG from the OS) was an internal error."""
+    (tmp_path / "g.bgr").write_text(f'asset M = "{"a" * 300}.obj"\nLot --> extrude(2) i(M)\n')
+    out = run("derive", "g.bgr", "-o", "x.glb", cwd=tmp_path)
+    assert out.returncode == 1, out.stderr
+    assert "g.bgr:1:7: error: asset file" in out.stderr and "cannot be opened" in out.stderr
+    assert "internal error" not in out.stderr
+    assert not (tmp_path / "x.glb").exists()

@@ -70,7 +70,13 @@ def _load_asset(app, step, module, asset):
         check_input(path, "asset file")
     except BgrError as e:  # located at the asset line, as the other asset errors are
         raise runtime_error(module, asset.pos, e.message, e.hint) from None
-    if not path.is_file():
+    try:
+        found = path.is_file()
+    except (OSError, ValueError) as e:  # a name the system refuses: too long, a NUL byte
+        raise runtime_error(
+            module, asset.pos, f"asset file '{asset.path[:200]}' cannot be opened: {e.strerror}"
+        ) from None
+    if not found:
         raise runtime_error(
             module, asset.pos, f"asset file '{asset.path}' not found", f"looked for {path}"
         )
