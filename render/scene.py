@@ -164,44 +164,29 @@ def from_trimesh(
     return Scene(triangles=triangles, colors=rgb.copy(), part=part, label=label, labels=labels)
 
 
-def _glb_materials(gltf: dict) -> tuple[list[str], np.ndarray]:
-    """(material names, material index of each face) in the order ``read_glb`` emits faces.
+def _glb_materials(gltf: dict, blob: bytes) -> tuple[list[str], np.ndarray]:
+    """(material names, material index of each face) in the order ``world_mesh`` emits faces.
 
-    ``read_glb`` keeps no material per face, so this walks the same nodes, instances and
-    primitives in the same order, counting faces from the accessors' ``count`` alone.
+    ``world_mesh`` keeps no material per face, so this walks the same nodes, instances and
+    primitives in the same order (``mesh_nodes``), counting faces from the accessors' ``count``
+    alone.  It runs after ``world_mesh``, which has checked all of them.
     """
-    nodes, meshes = gltf.get("nodes", []), gltf.get("meshes", [])
+    from ..formats.glb_read import instance_count, mesh_nodes, scene_roots, triangle_primitives
+
     names = []
-    for k, mat in enumerate(gltf.get("materials", [])):
+    materials = gltf.get("materials")
+    for k, mat in enumerate(materials if isinstance(materials, list) else []):
+        mat = mat if isinstance(mat, dict) else {}
         extras = mat.get("extras") if isinstance(mat.get("extras"), dict) else {}
-        names.append(
-            extras.get("material") or mat.get("name") or extras.get("color") or f"material {k}"
-        )
+        name = extras.get("material") or mat.get("name") or extras.get("color")
+        names.append(name if isinstance(name, str) else f"material {k}")
     out: list[np.ndarray] = []
-
-    def visit(index: int) -> None:
-        node = nodes[index]
-        if "mesh" in node:
-            inst = node.get("extensions", {}).get("EXT_mesh_gpu_instancing")
-            copies = (
-                gltf["accessors"][next(iter(inst["attributes"].values()))]["count"] if inst else 1
-            )
-            for prim in meshes[node["mesh"]]["primitives"]:
-                if prim.get("mode", 4) != 4:
-                    continue
-                source = prim["indices"] if "indices" in prim else prim["attributes"]["POSITION"]
-                n = gltf["accessors"][source]["count"] // 3 * copies
-                out.append(np.full(n, prim.get("material", -1), dtype=np.int64))
-        for child in node.get("children", []):
-            visit(child)
-
-    if gltf.get("scenes"):
-        roots = gltf["scenes"][gltf.get("scene", 0)].get("nodes", [])
-    else:
-        children = {c for node in nodes for c in node.get("children", [])}
-        roots = [i for i in range(len(nodes)) if i not in children]
-    for root in roots:
-        visit(root)
+    for i, node, _ in mesh_nodes(gltf, scene_roots(gltf)):
+        copies = instance_count(gltf, blob, node, i) or 1
+        for _, prim in triangle_primitives(gltf, node, i):
+            source = prim["indices"] if "indices" in prim else prim["attributes"]["POSITION"]
+            n = gltf["accessors"][source]["count"] // 3 * copies
+            out.append(np.full(n, prim.get("material", -1), dtype=np.int64))
     return names, (np.concatenate(out) if out else np.zeros(0, dtype=np.int64))
 
 
@@ -226,8 +211,7 @@ def _model_errors(shown: str, what: str, hint: str, caught: tuple = (Exception,)
 
 def from_gltf(path: str | os.PathLike) -> Scene:
     """A .glb or .gltf file, instances expanded (``read_glb``); parts and labels by material."""
-    from ..formats.glb_read import parse, read_glb
-    from ..grammar.paths import read_input
+    from ..formats.glb_read import load, scene_roots, world_mesh
 
     shown = str(path)
     with _model_errors(
@@ -236,10 +220,9 @@ def from_gltf(path: str | os.PathLike) -> Scene:
         "bgr reads triangle meshes with float positions",
         (ValueError, KeyError, IndexError, TypeError, AttributeError, StopIteration),
     ):
-        data = read_input(path, "model file")
-        gltf, _ = parse(data)
-        mesh = read_glb(path)
-        names, material = _glb_materials(gltf)
+        gltf, blob = load(path)
+        mesh = world_mesh(gltf, blob, scene_roots(gltf))
+        names, material = _glb_materials(gltf, blob)
     return from_trimesh(mesh, names, material)
 
 

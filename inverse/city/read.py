@@ -733,36 +733,35 @@ def _reason(exc: BaseException) -> str:
 def _read_gltf(path: str | Path) -> Found:
     """A .glb/.gltf's triangles, an object per node under the scene's one root node (bgr's
     tree: root, then a node per lot), else per root node; when that makes one object, its
-    connected components are the objects instead."""
-    from bgr.formats.glb_read import node_matrix, parse, scene_roots, world_mesh
+    connected components are the objects instead.  The file is checked as it is read
+    (formats/gltf_checks.py), its triangles counted for the whole scene before any is made."""
+    from bgr.formats.glb_read import check_scene, node_matrix, parse, scene_roots, world_mesh
+    from bgr.grammar.paths import resolved
 
     shown = str(path)
     data = _read_bytes(path, shown)
     parts: list[tuple[str, trimesh.Trimesh, dict]] = []
     try:
-        gltf, blob = parse(data)
-        if not blob and shown.lower().endswith(".gltf"):
-            blob = _external_buffer(path, gltf)
+        gltf, blob = parse(data, resolved(path).parent)
         nodes = gltf.get("nodes", [])
         roots = scene_roots(gltf)
+        check_scene(gltf, blob, roots)
         if len(roots) == 1 and nodes[roots[0]].get("children"):
             root = nodes[roots[0]]
             alone = {key: value for key, value in root.items() if key != "children"}
-            parts.append(
-                (_node_name(root, roots[0]), world_mesh({**gltf, "nodes": [alone]}, blob, [0]), {})
-            )
-            world = node_matrix(root)
+            own = world_mesh({**gltf, "nodes": [alone]}, blob, [0], checked=True)
+            parts.append((_node_name(root, roots[0]), own, {}))
+            world = node_matrix(root, roots[0])
             for child in root["children"]:
-                mesh = world_mesh(gltf, blob, [child], world)
+                mesh = world_mesh(gltf, blob, [child], world, checked=True)
                 parts.append((_node_name(nodes[child], child), mesh, _extras(nodes[child])))
         else:
             for r in roots:
-                parts.append(
-                    (_node_name(nodes[r], r), world_mesh(gltf, blob, [r]), _extras(nodes[r]))
-                )
+                mesh = world_mesh(gltf, blob, [r], checked=True)
+                parts.append((_node_name(nodes[r], r), mesh, _extras(nodes[r])))
     except BgrError as exc:
         raise BgrError(
-            Diagnostic(shown, 0, 0, f"not a glTF file bgr can read: {exc.message}")
+            Diagnostic(shown, 0, 0, f"not a glTF file bgr can read: {exc.message}", exc.hint)
         ) from None
     except (
         ValueError,
@@ -787,21 +786,6 @@ def _node_name(node: dict, index: int) -> str:
 def _extras(node: dict) -> dict:
     extras = node.get("extras")
     return dict(extras) if isinstance(extras, dict) else {}
-
-
-def _external_buffer(path: str | Path, gltf: dict) -> bytes:
-    """Buffer 0 of a .gltf that keeps it in a file beside it (``"uri": "scene.bin"``)."""
-    uri = (gltf.get("buffers") or [{}])[0].get("uri")
-    if not isinstance(uri, str) or not uri:
-        return b""
-    folder = Path(path).resolve().parent
-    target = (folder / uri).resolve()
-    if not target.is_relative_to(folder):
-        raise ValueError("its buffer lies outside the file's folder")
-    try:
-        return read_input(target, "glTF buffer")
-    except OSError as exc:
-        raise ValueError(f"cannot read its buffer {uri}: {exc.strerror}") from None
 
 
 def _gathered(parts: list[tuple[str, trimesh.Trimesh, dict]]) -> Found:
