@@ -168,6 +168,28 @@ def test_a_far_gltf_vertex_names_its_node(tmp_path):
     assert "object 'far'" in caught.value.message and "is beyond" in caught.value.message
 
 
+@pytest.mark.parametrize(("key", "value"), [("origin", [1e308, 0, 0]), ("size", [1e308, 1e308, 1])])
+def test_a_far_terminal_of_a_terminal_list_is_named(key, value):
+    """bgr infer --kind schema took a terminal at 1e308, then blamed itself: the grammar it
+    inferred did not derive ("this is a bug in bgr infer")."""
+    from bgr.inverse.schema.terminals import read_terminals
+
+    terminal = {
+        "label": "Wall",
+        "rule": "Wall",
+        "path": "Lot/Wall.0",
+        "origin": [0, 0, 0],
+        "axes": [[1, 0, 0], [0, 1, 0], [0, 0, 1]],
+        "size": [10, 8, 0],
+        "geometry": "polygon",
+    }
+    terminal[key] = value
+    with pytest.raises(BgrError) as caught:
+        read_terminals({"terminals": [terminal]}, "house.json")
+    assert caught.value.path == "house.json"
+    assert caught.value.message.startswith(f"terminals[0].{key} must be a list of 3 finite")
+
+
 # ---- boxes: sizes ------------------------------------------------------------------------------
 
 
