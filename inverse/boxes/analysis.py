@@ -297,6 +297,8 @@ def _lowest_and_highest(free, edge, lo, hi) -> tuple[list[int], list[int]]:
     left = np.flatnonzero(free)
     a, b = edge
     keep = free[a] & free[b]
+    if not keep.any():  # boxes apart from one another: each its own lowest and highest
+        return left.tolist(), left.tolist()
     where = np.full(len(free), -1)
     where[left] = np.arange(len(left))
     graph = coo_matrix(
@@ -315,26 +317,29 @@ def _lowest_and_highest(free, edge, lo, hi) -> tuple[list[int], list[int]]:
 
 def _longest_path(order, succ, free, starts, ends: set[int]) -> list[int]:
     """The longest path (in boxes) through free boxes from a start to an end, by dynamic
-    programming over the topological order; ties go to the earlier box in that order."""
+    programming over the topological order; ties go to the earlier box in that order.  Python
+    lists, not arrays: a node of many children runs it once per sequence, over all of them."""
     n = len(order)
-    length = np.zeros(n, dtype=int)  # 0: not reached
-    before = -np.ones(n, dtype=int)
+    free = free.tolist()
+    length = [0] * n  # 0: not reached
+    before = [-1] * n
     for s in starts:
         if free[s]:
             length[s] = 1
     best, best_len = -1, 0
     for i in order:
-        if not free[i] or length[i] == 0:
+        here = length[i]
+        if not here or not free[i]:
             continue
-        if i in ends and length[i] > best_len:
-            best, best_len = i, length[i]
+        if here > best_len and i in ends:
+            best, best_len = i, here
         for j in succ[i]:
-            if free[j] and length[i] + 1 > length[j]:
-                length[j] = length[i] + 1
+            if free[j] and here + 1 > length[j]:
+                length[j] = here + 1
                 before[j] = i
     if best < 0:  # no end reachable (boxes hanging free): the first free box alone
         best = next(i for i in order if free[i])
-    path = [best]
+    path = [int(best)]
     while before[path[-1]] >= 0:
         path.append(int(before[path[-1]]))
     return path[::-1]
