@@ -29,6 +29,7 @@ from .interpreter.limits import (
     DEFAULT_MAX_TRIANGLES,
     default_max_memory,
     format_bytes,
+    memory_ceiling,
     parse_memory,
 )
 
@@ -267,6 +268,7 @@ def build_parser() -> argparse.ArgumentParser:
         metavar="DIR",
         help=ALLOW_PATH_HELP,
     )
+    add_memory_option(infer)
 
     city = infer.add_argument_group("--kind city")
     city.add_argument(
@@ -360,8 +362,10 @@ def build_parser() -> argparse.ArgumentParser:
         type=_whole,
         default=200_000,
         metavar="N",
-        help="refuse a result of more than N boxes (default 200000: about 1 GB and 10 s)",
+        help="refuse an input or a result of more than N boxes (default 200000: about 1 GB "
+        "and 10 s)",
     )
+    add_memory_option(retarget)
     retarget.add_argument(
         "--allow-path",
         action="append",
@@ -462,12 +466,32 @@ def add_budget_options(command: argparse.ArgumentParser) -> None:
         help=f"triangle budget of the terminals, of the run or of each lot as --max-shapes "
         f"(default {DEFAULT_MAX_TRIANGLES:,})",
     )
+    add_memory_option(command)
+
+
+def add_memory_option(command: argparse.ArgumentParser) -> None:
+    """--max-memory: derive and render, and the commands that read data (infer, retarget)."""
     command.add_argument(
         "--max-memory",
         metavar="SIZE",
         help="memory ceiling on what the run allocates, e.g. 4G or 512M (default: 80%% of the "
         "memory available at start)",
     )
+
+
+def memory_limit(args) -> int | None | str:
+    """The --max-memory ceiling in bytes (None: unknown, none enforced), or what is wrong with
+    it.  The process's address space is capped a little above it (:func:`cap_address_space`)."""
+    if args.max_memory is None:
+        memory = default_max_memory()
+    else:
+        memory = parse_memory(args.max_memory)
+        if memory is None:
+            return f"--max-memory {args.max_memory}: write a size such as 4G, 512M or 1.5GB"
+    args.memory_ceiling = memory  # for main()'s out-of-memory message
+    if memory is not None:
+        cap_address_space(memory)
+    return memory
 
 
 def budgets(args) -> dict | str:
@@ -480,15 +504,9 @@ def budgets(args) -> dict | str:
     """
     if args.max_depth < 1 or args.max_shapes < 1 or args.max_triangles < 1:
         return "--max-depth, --max-shapes and --max-triangles must be positive"
-    if args.max_memory is None:
-        memory = default_max_memory()
-    else:
-        memory = parse_memory(args.max_memory)
-        if memory is None:
-            return f"--max-memory {args.max_memory}: write a size such as 4G, 512M or 1.5GB"
-    args.memory_ceiling = memory  # for main()'s out-of-memory message
-    if memory is not None:
-        cap_address_space(memory)
+    memory = memory_limit(args)
+    if isinstance(memory, str):
+        return memory
     return {
         "max_depth": args.max_depth,
         "max_shapes": args.max_shapes,
@@ -742,6 +760,16 @@ def _progress(lots: int, output: str):
 
 
 def cmd_infer(args) -> int:
+    """bgr infer under its memory ceiling (--max-memory; checked by the inverse modules)."""
+    memory = memory_limit(args)
+    if isinstance(memory, str):
+        print(f"bgr infer: {memory}", file=sys.stderr)
+        return EXIT_USAGE
+    with memory_ceiling(memory, args.input, "infer from a smaller input"):
+        return _infer(args)
+
+
+def _infer(args) -> int:
     from .inverse.inputs import check_input
 
     if args.kind in (None, "schema", "city", "boxes"):
@@ -911,7 +939,12 @@ def cmd_render(args) -> int:
 def cmd_retarget(args) -> int:
     from .inverse.boxes.command import run_retarget
 
-    return run_retarget(args)
+    memory = memory_limit(args)
+    if isinstance(memory, str):
+        print(f"bgr retarget: {memory}", file=sys.stderr)
+        return EXIT_USAGE
+    with memory_ceiling(memory, args.input, "ask a smaller size, or give fewer boxes"):
+        return run_retarget(args)
 
 
 COMMANDS = {
@@ -921,6 +954,15 @@ COMMANDS = {
     "derive": cmd_derive,
     "render": cmd_render,
     "infer": cmd_infer,
+}
+
+
+# what main()'s out-of-memory message advises besides --max-memory, by command
+OUT_OF_MEMORY = {
+    "derive": "derive fewer or smaller shapes",
+    "render": "derive fewer or smaller shapes",
+    "infer": "infer from a smaller input",
+    "retarget": "ask a smaller size, or give fewer boxes",
 }
 
 
@@ -950,9 +992,10 @@ def main(argv: list[str] | None = None) -> int:
         print("bgr: interrupted", file=sys.stderr)
         return EXIT_INTERRUPTED
     except MemoryError:
+        smaller = OUT_OF_MEMORY.get(args.command, OUT_OF_MEMORY["derive"])
         print(
             f"bgr {args.command}: out of memory (the ceiling is "
-            f"{_ceiling(args)}); derive fewer or smaller shapes, or raise it with --max-memory",
+            f"{_ceiling(args)}); {smaller}, or raise it with --max-memory",
             file=sys.stderr,
         )
         return EXIT_INPUT

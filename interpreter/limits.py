@@ -10,10 +10,14 @@ seconds instead of exhausting it.  The defaults are chosen on the project's 2-co
 
 from __future__ import annotations
 
+import contextlib
 import math
 import os
 import re
 import sys
+from collections.abc import Iterator
+
+from bgr.grammar.errors import BgrError, Diagnostic
 
 DEFAULT_MAX_DEPTH = 256
 """Rule applications nested in one another (a rule calling itself without end)."""
@@ -30,6 +34,11 @@ MAX_COORDINATE = 1e9
 """Largest scope size or coordinate, in metres, any shape may have.  Projected city
 coordinates reach 1e7 (a UTM northing); past 1e9 float32 files lose the metre and products
 of sizes overflow, so a larger value is a grammar's mistake, reported where it happens."""
+
+MAX_INPUT_COORDINATE = 1e8
+"""Largest |coordinate|, in metres, of a model read as data (the cities of ``bgr infer``): the
+bound of a lot's footprint (interpreter/values.py).  A projected CRS reaches 2e7 m; a vertex at
+1e308 is an exporter's mistake, and it would hang GEOS and crash scipy's k-means further on."""
 
 BYTES_PER_SHAPE = 1000
 """What one shape costs while deriving, roughly (its piece, its Shape, its terminal row):
@@ -50,6 +59,16 @@ def memory_in_use() -> int:
     try:
         import resource
     except ImportError:  # Windows: no measurement, so no ceiling is enforced
+        return 0
+    peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
+    return peak if sys.platform == "darwin" else peak * 1024
+
+
+def peak_memory() -> int:
+    """The most resident memory this process has held, in bytes (0 when unknown)."""
+    try:
+        import resource
+    except ImportError:
         return 0
     peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
     return peak if sys.platform == "darwin" else peak * 1024
@@ -113,3 +132,76 @@ def format_bytes(count: float) -> str:
         if count >= size:
             return f"{count / size:.3g} {unit}"
     return f"{int(count)} bytes"
+
+
+class MemoryCeiling:
+    """The memory ceiling of a command that does not derive (``bgr infer``, ``bgr retarget``),
+    measured as the engine measures a derivation: the process's resident memory less what it
+    held when the work began, so what a notebook or a test session held before does not
+    count.  Checked at each step of the work, and before an array whose size is known up front
+    is allocated (``more``), so a large input stops with a located error instead of swapping."""
+
+    def __init__(self, limit: int, path: str = "", hint: str = "") -> None:
+        self.limit, self.path, self.hint = limit, path, hint
+        self.restart()
+
+    def restart(self) -> None:
+        """Count from now."""
+        self.base, self.peak = memory_in_use(), peak_memory()
+
+    def used(self) -> int:
+        """What the run has grown by: now, or at its peak since the start where the process's
+        peak has risen since (a step's arrays freed before the next look still count)."""
+        return max(memory_in_use() - self.base, peak_memory() - max(self.peak, self.base))
+
+    def check(self, step: str, more: int = 0) -> None:
+        """A BgrError naming ``step`` when the run has grown past the ceiling, or would with
+        ``more`` bytes."""
+        used = self.used()
+        if used + max(more, 0) > self.limit:
+            needs = f"{step} needs more than {format_bytes(self.limit)} of memory"
+            if more > 0:
+                needs += f" ({format_bytes(more)} more, {format_bytes(max(used, 0))} in use)"
+            raise BgrError(
+                Diagnostic(
+                    self.path,
+                    0,
+                    0,
+                    needs,
+                    (self.hint + ", or raise" if self.hint else "Raise")
+                    + " the ceiling with --max-memory SIZE",
+                )
+            )
+
+
+# the ceiling in force (process-wide, as the address-space cap is: the threads a step starts
+# see it too)
+_CEILING: list[MemoryCeiling | None] = [None]
+
+
+@contextlib.contextmanager
+def memory_ceiling(limit: int | None, path: str = "", hint: str = "") -> Iterator[None]:
+    """Within the block, :func:`check_memory` holds the work to ``limit`` bytes from now (None:
+    no ceiling).  The inverse modules call check_memory at their expensive steps; the command
+    line opens the block with --max-memory, library callers may too."""
+    before = _CEILING[0]
+    _CEILING[0] = None if limit is None else MemoryCeiling(limit, path, hint)
+    try:
+        yield
+    finally:
+        _CEILING[0] = before
+
+
+def restart_memory() -> None:
+    """Count the ceiling in force from now: a command calls it once its modules are loaded, so
+    that importing numpy, scipy and trimesh (about 100 MB) is not taken for its work."""
+    ceiling = _CEILING[0]
+    if ceiling is not None:
+        ceiling.restart()
+
+
+def check_memory(step: str, more: int = 0) -> None:
+    """The active ceiling's :meth:`MemoryCeiling.check`; nothing outside a memory_ceiling()."""
+    ceiling = _CEILING[0]
+    if ceiling is not None:
+        ceiling.check(step, more)

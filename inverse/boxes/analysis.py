@@ -22,7 +22,13 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .model import EPS, Box
+from bgr.grammar.errors import BgrError, Diagnostic
+from bgr.interpreter.limits import check_memory
+
+from .model import EPS, MAX_CHILDREN, PAIRS_AT_ONCE, Box
+
+SPARSE_COST = 30  # a product of a sparse product costs about as much as 30 of a dense one
+PAIR_BYTES = 16  # what the n x n arrays of a node's analysis cost per pair of its children
 
 
 @dataclass
@@ -120,52 +126,119 @@ def alignment_groups(root: Box, axis: int) -> dict[int, list[float]]:
 
 def _contacts(lo: np.ndarray, hi: np.ndarray, axis: int) -> np.ndarray:
     """touch[i, j]: box j rests on box i across ``axis`` with overlapping cross-sections."""
-    others = [a for a in range(3) if a != axis]
-    touch = np.abs(hi[:, None, axis] - lo[None, :, axis]) <= EPS
-    for a in others:
-        touch &= (
-            np.minimum(hi[:, None, a], hi[None, :, a]) - np.maximum(lo[:, None, a], lo[None, :, a])
-        ) > EPS
-    return touch
+    return _blocks(_touch_rows, lo, hi, axis)
 
 
 def _below(lo: np.ndarray, hi: np.ndarray, axis: int) -> np.ndarray:
     """below[i, j]: box i lies under box j along ``axis``, their cross-sections overlapping
     (so that i must stay under j whatever their lengths become)."""
+    return _blocks(_below_rows, lo, hi, axis)
+
+
+def _blocks(relation, lo: np.ndarray, hi: np.ndarray, axis: int) -> np.ndarray:
+    """``relation`` of every pair of boxes, a block of rows at a time: only the n x n booleans
+    are kept, the float64 differences of a block stay within PAIRS_AT_ONCE pairs (all of them
+    at once took 12 GB for 10,000 children)."""
+    n = len(lo)
+    out = np.empty((n, n), dtype=bool)
+    step = max(1, PAIRS_AT_ONCE // max(n, 1))
+    for start in range(0, n, step):
+        rows = slice(start, min(start + step, n))
+        out[rows] = relation(lo[rows], hi[rows], lo, hi, axis)
+    return out
+
+
+def _across(lo_r, hi_r, lo, hi, axis: int) -> np.ndarray:
+    """Rows' boxes against all: their cross-sections (the two other axes) overlap by more than
+    EPS.  min(hi) - max(lo) > EPS is each of the four differences > EPS (the least of them is
+    the one min - max picks, rounding and all): two of them are the boxes' own sizes."""
+    out = np.ones((len(lo_r), len(lo)), dtype=bool)
+    for a in range(3):
+        if a != axis:
+            out &= hi_r[:, None, a] - lo[None, :, a] > EPS
+            out &= hi[None, :, a] - lo_r[:, None, a] > EPS
+            out &= (hi_r[:, a] - lo_r[:, a] > EPS)[:, None] & (hi[:, a] - lo[:, a] > EPS)[None, :]
+    return out
+
+
+def _touch_rows(lo_r, hi_r, lo, hi, axis: int) -> np.ndarray:
+    return (np.abs(hi_r[:, None, axis] - lo[None, :, axis]) <= EPS) & _across(
+        lo_r, hi_r, lo, hi, axis
+    )
+
+
+def _below_rows(lo_r, hi_r, lo, hi, axis: int) -> np.ndarray:
+    under = (hi_r[:, None, axis] <= lo[None, :, axis] + EPS) & (
+        lo_r[:, None, axis] < lo[None, :, axis]
+    )
+    return under & _across(lo_r, hi_r, lo, hi, axis)
+
+
+def _side_rows(lo_r, hi_r, lo, hi, axis: int) -> np.ndarray:
+    """side[i, j]: box i and box j share a whole face beside each other (the same interval
+    along ``axis`` and along the third axis)."""
+
+    def near(x: np.ndarray, y: np.ndarray) -> np.ndarray:
+        return np.abs(x[:, None] - y[None, :]) <= EPS
+
+    same = near(lo_r[:, axis], lo[:, axis]) & near(hi_r[:, axis], hi[:, axis])
+    out = np.zeros(same.shape, dtype=bool)
     others = [a for a in range(3) if a != axis]
-    out = (hi[:, None, axis] <= lo[None, :, axis] + EPS) & (lo[:, None, axis] < lo[None, :, axis])
-    for a in others:
-        out &= (
-            np.minimum(hi[:, None, a], hi[None, :, a]) - np.maximum(lo[:, None, a], lo[None, :, a])
-        ) > EPS
+    for k, c in enumerate(others):
+        d = others[1 - k]
+        out |= near(hi_r[:, c], lo[:, c]) & near(lo_r[:, d], lo[:, d]) & near(hi_r[:, d], hi[:, d])
+    return out & same
+
+
+def _nothing_between(under: np.ndarray) -> np.ndarray:
+    """[i, j]: no box k lies under j and over i.  As a sparse product where few boxes are under
+    others (a grid's columns: about n^1.5 pairs), else in float32 by BLAS, a block of rows at a
+    time (a tower, where every box is under every box above it)."""
+    n = len(under)
+    work = float(under.sum(axis=0).astype(np.float64) @ under.sum(axis=1))  # sparse products
+    if work * SPARSE_COST < float(n) ** 3:
+        from scipy.sparse import csr_matrix
+
+        weights = csr_matrix(under, dtype=np.float32)
+        out = np.ones((n, n), dtype=bool)
+        out[(weights @ weights).nonzero()] = False
+        return out
+    weights = under.astype(np.float32)
+    out = np.empty((n, n), dtype=bool)
+    step = max(1, 8 * PAIRS_AT_ONCE // max(n, 1))  # large blocks: BLAS is fastest on those
+    for start in range(0, n, step):
+        rows = slice(start, min(start + step, n))
+        out[rows] = (weights[rows] @ weights) == 0
     return out
 
 
 def analyse_node(box: Box, axis: int) -> NodeAnalysis:
     kids = box.children
     n = len(kids)
+    if n > MAX_CHILDREN:  # the commands refuse such an input: these are copies
+        raise BgrError(
+            Diagnostic(
+                "",
+                0,
+                0,
+                f"along {'xyz'[axis]}, box '{box.id}' has {n:,} children (with the copies made "
+                f"along an earlier axis), more than the {MAX_CHILDREN:,} bgr analyses in one box",
+                "ask a smaller size, or another --order, so that fewer copies are made first",
+            )
+        )
+    check_memory(f"analysing the {n:,} children of box '{box.id}'", n * n * PAIR_BYTES)
     lo = np.array([c.lo for c in kids])
     hi = np.array([c.hi for c in kids])
     tags = [c.tags[axis] for c in kids]
     others = [a for a in range(3) if a != axis]
     up = _contacts(lo, hi, axis)
-    side = np.zeros((n, n), dtype=bool)
-    for k, c in enumerate(others):
-        d = others[1 - k]
-        coincide = (
-            (np.abs(hi[:, None, c] - lo[None, :, c]) <= EPS)
-            & (np.abs(lo[:, None, axis] - lo[None, :, axis]) <= EPS)
-            & (np.abs(hi[:, None, axis] - hi[None, :, axis]) <= EPS)
-            & (np.abs(lo[:, None, d] - lo[None, :, d]) <= EPS)
-            & (np.abs(hi[:, None, d] - hi[None, :, d]) <= EPS)
-        )
-        side |= coincide
+    side = _blocks(_side_rows, lo, hi, axis)
     same_tag = np.array(tags)[:, None] == np.array(tags)[None, :]
     side &= same_tag
     under = _below(lo, hi, axis)
     # boxes with empty space between them (children need not fill their parent) follow each
     # other too when nothing lies between: the space scales like an S box in their sequence
-    step = up | (under & ~((under.astype(np.float32) @ under.astype(np.float32)) > 0))
+    step = up | (under & _nothing_between(under))
     edge = step | side
     # a topological order: every edge goes up, or sideways towards larger coordinates
     order = sorted(
@@ -179,7 +252,8 @@ def analyse_node(box: Box, axis: int) -> NodeAnalysis:
     )
     rank = np.empty(n, dtype=int)
     rank[order] = np.arange(n)
-    edges = [(int(i), int(j)) for i, j in zip(*np.nonzero(edge), strict=True)]
+    pairs = np.nonzero(edge)
+    edges = [(int(i), int(j)) for i, j in zip(*pairs, strict=True)]
     succ: list[list[int]] = [[] for _ in range(n)]
     for i, j in edges:
         if rank[i] < rank[j]:  # degenerate (zero-length) boxes could otherwise make a cycle
@@ -198,7 +272,7 @@ def analyse_node(box: Box, axis: int) -> NodeAnalysis:
             # the primary ends at a box touching the top (the whole height, in a tessellation)
             ends = [i for i in range(n) if hi[i, axis] >= top - EPS] or list(range(n))
         else:
-            starts, ends = _lowest_and_highest(free, edge, lo[:, axis], hi[:, axis])
+            starts, ends = _lowest_and_highest(free, pairs, lo[:, axis], hi[:, axis])
         path = _longest_path(order, succ, free, starts, set(ends))
         used[path] = True
         units = _units(path, lo[:, axis], hi[:, axis], tags)
@@ -214,53 +288,58 @@ def analyse_node(box: Box, axis: int) -> NodeAnalysis:
 
 
 def _lowest_and_highest(free, edge, lo, hi) -> tuple[list[int], list[int]]:
-    """The lowest and highest boxes of every component of the graph left (undirected)."""
-    n = len(free)
-    comp = -np.ones(n, dtype=int)
-    starts: list[int] = []
-    ends: list[int] = []
-    sym = edge | edge.T
-    for seed in np.nonzero(free)[0]:
-        if comp[seed] >= 0:
-            continue
-        members, stack = [], [int(seed)]
-        comp[seed] = seed
-        while stack:
-            i = stack.pop()
-            members.append(i)
-            for j in np.nonzero(sym[i] & free)[0]:
-                if comp[j] < 0:
-                    comp[j] = seed
-                    stack.append(int(j))
-        low = min(lo[members])
-        high = max(hi[members])
-        starts += [i for i in members if lo[i] <= low + EPS]
-        ends += [i for i in members if hi[i] >= high - EPS]
-    return sorted(starts), sorted(ends)
+    """The lowest and highest boxes of every component of the graph left (undirected): ``edge``
+    is the graph's edges as (from, to) arrays, so that a node of many children, which has many
+    sequences, costs no n x n work for each."""
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import connected_components
+
+    left = np.flatnonzero(free)
+    a, b = edge
+    keep = free[a] & free[b]
+    if not keep.any():  # boxes apart from one another: each its own lowest and highest
+        return left.tolist(), left.tolist()
+    where = np.full(len(free), -1)
+    where[left] = np.arange(len(left))
+    graph = coo_matrix(
+        (np.ones(int(keep.sum()), dtype=np.int8), (where[a[keep]], where[b[keep]])),
+        (len(left), len(left)),
+    )
+    _, comp = connected_components(graph, directed=False)
+    low = np.full(comp.max(initial=-1) + 1, np.inf)
+    high = np.full(len(low), -np.inf)
+    np.minimum.at(low, comp, lo[left])
+    np.maximum.at(high, comp, hi[left])
+    starts = left[lo[left] <= low[comp] + EPS]
+    ends = left[hi[left] >= high[comp] - EPS]
+    return starts.tolist(), ends.tolist()
 
 
 def _longest_path(order, succ, free, starts, ends: set[int]) -> list[int]:
     """The longest path (in boxes) through free boxes from a start to an end, by dynamic
-    programming over the topological order; ties go to the earlier box in that order."""
+    programming over the topological order; ties go to the earlier box in that order.  Python
+    lists, not arrays: a node of many children runs it once per sequence, over all of them."""
     n = len(order)
-    length = np.zeros(n, dtype=int)  # 0: not reached
-    before = -np.ones(n, dtype=int)
+    free = free.tolist()
+    length = [0] * n  # 0: not reached
+    before = [-1] * n
     for s in starts:
         if free[s]:
             length[s] = 1
     best, best_len = -1, 0
     for i in order:
-        if not free[i] or length[i] == 0:
+        here = length[i]
+        if not here or not free[i]:
             continue
-        if i in ends and length[i] > best_len:
-            best, best_len = i, length[i]
+        if here > best_len and i in ends:
+            best, best_len = i, here
         for j in succ[i]:
-            if free[j] and length[i] + 1 > length[j]:
-                length[j] = length[i] + 1
+            if free[j] and here + 1 > length[j]:
+                length[j] = here + 1
                 before[j] = i
     if best < 0:  # no end reachable (boxes hanging free): the first free box alone
         best = next(i for i in order if free[i])
-    path = [best]
+    path = [int(best)]
     while before[path[-1]] >= 0:
         path.append(int(before[path[-1]]))
     return path[::-1]

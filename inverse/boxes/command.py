@@ -16,10 +16,11 @@ from bgr.formats.atomic import write_text as write_atomic
 from bgr.grammar.errors import BgrError, Diagnostic
 from bgr.grammar.formatter import format_module
 from bgr.grammar.paths import check_input, check_output, roots_of, within
+from bgr.interpreter.limits import restart_memory
 
 from .analysis import min_length
 from .emit import ATTRS, write
-from .model import AXES, EPS, Box, dumps, read
+from .model import AXES, EPS, MAX_BOXES, MAX_CHILDREN, Box, dumps, read
 from .retarget import alignments, check_order, retarget
 
 USAGE = 2
@@ -47,7 +48,9 @@ def run_retarget(args) -> int:
         return USAGE
     out = None if args.output in (None, "-") else Path(args.output)
     source = Path(args.input)
-    root = read(source)
+    restart_memory()  # the ceiling (--max-memory) counts from here, the modules loaded
+    # refused here when too large to analyse, before any work on pairs of boxes
+    root = read(source, max_boxes=args.max_boxes, max_children=MAX_CHILDREN)
     try:
         result = retarget(root, size, args.order, max_boxes=args.max_boxes)
         kept, total = alignments(root, result)
@@ -241,10 +244,11 @@ def shade(rgb: tuple[float, float, float], box: Box) -> tuple[float, float, floa
 
 def run_infer(args) -> int:
     source = Path(args.input)
+    restart_memory()  # the ceiling (--max-memory) counts from here, the modules loaded
     out = None if args.output in (None, "-") else Path(args.output)
     if out is not None:
         check_grammar_output(out)
-    root = read(source)
+    root = read(source, max_boxes=MAX_BOXES, max_children=MAX_CHILDREN)
     try:
         written = write(root, str(args.input), source.parent, (out or Path("x")).parent)
         text = format_module(written.module)

@@ -23,6 +23,14 @@ from bgr.grammar.paths import read_input
 AXES = "xyz"
 BEHAVIOURS = ("S", "R", "F")
 EPS = 1e-6  # metres: faces closer than this coincide (the paper's epsilon-precision)
+MAX_BOXES = 200_000  # a retargeting making more is refused: a size asked by mistake (~1 GB)
+MAX_CHILDREN = 4_000
+"""Children of one box that bgr retarget and bgr infer --kind boxes analyse at most, in the
+input or among the copies an axis retargeted first has made.  The analysis compares every two
+children of a box along each axis (16 bytes a pair, and in a tower a matrix product): 4,000
+children cost 250 MB and 2 to 6 s an axis; 10,000 asked for 12 GB before this limit.  No
+modelled building comes near it (docs/limits.md)."""
+PAIRS_AT_ONCE = 1 << 20  # pairs of boxes compared in one numpy step (24 MB of float64 each)
 FORMAT = '{"root": {"id": ..., "min": [x, y, z], "max": [x, y, z], "children": [...]}}'
 MESH_PATH, MESH_NAME = 4096, 255  # a mesh path's characters and a name's bytes (PATH_MAX, NAME_MAX)
 READS = f"a boxes file is a JSON object {FORMAT} (docs/inverse-boxes.md)"
@@ -115,7 +123,7 @@ def dumps(root: Box) -> str:
 # ---- reading -------------------------------------------------------------------------------
 
 
-def read(path: str | Path) -> Box:
+def read(path: str | Path, *, max_boxes: int | None = None, max_children: int | None = None) -> Box:
     """The hierarchy in a boxes JSON file, checked (:func:`parse`)."""
     path = Path(path)
     try:
@@ -139,12 +147,20 @@ def read(path: str | Path) -> Box:
             f"{READS}; a grammar is resized by bgr derive --lot W,D (or --set), and bgr infer "
             "--kind schema infers from one",
         )
-    return parse(text, str(path))
+    return parse(text, str(path), max_boxes=max_boxes, max_children=max_children)
 
 
-def parse(text: str, name: str = "<boxes>") -> Box:
+def parse(
+    text: str,
+    name: str = "<boxes>",
+    *,
+    max_boxes: int | None = None,
+    max_children: int | None = None,
+) -> Box:
     """Parse and check a boxes document; a BgrError naming the file, the line and the ids at
-    fault for anything a retargeting could not use."""
+    fault for anything a retargeting could not use, or (the commands ask it) for more boxes
+    than ``max_boxes`` or a box of more children than ``max_children``, before any work on
+    pairs of boxes."""
     try:
         doc = json.loads(text, parse_constant=_no_constant)
     except json.JSONDecodeError as e:
@@ -166,6 +182,7 @@ def parse(text: str, name: str = "<boxes>") -> Box:
         )
     ids: dict[str, str] = {}
     root = _box(doc["root"], name, "root", ids, fixed=(False, False, False))
+    check_sizes(root, name, max_boxes, max_children)
     problems = check(root)
     if problems:
         more = f" (and {len(problems) - 5} more)" if len(problems) > 5 else ""
@@ -286,6 +303,31 @@ def _path_problem(mesh: str) -> str | None:
     return f"a name of {longest:,} bytes" if longest > MESH_NAME else None
 
 
+def check_sizes(
+    root: Box, name: str | Path, max_boxes: int | None, max_children: int | None
+) -> None:
+    """A BgrError for a hierarchy too large to work on: more than ``max_boxes`` boxes (the
+    most a retargeting may make: the input is part of it), or a box of more than
+    ``max_children`` children (the analysis compares every two of them).  None: no limit."""
+    count = 0
+    for box in root.walk():
+        count += 1
+        if max_children is not None and len(box.children) > max_children:
+            raise _fail(
+                name,
+                f"box '{box.id}' has {len(box.children):,} children, more than the "
+                f"{max_children:,} bgr analyses in one box",
+                "group them into boxes of their own (a row, a floor, a bay): the analysis "
+                "compares every two children of a box",
+            )
+    if max_boxes is not None and count > max_boxes:
+        raise _fail(
+            name,
+            f"{count:,} boxes, more than the {max_boxes:,} a retargeting may make",
+            "bgr retarget --max-boxes N raises the limit",
+        )
+
+
 def check(root: Box, eps: float = EPS) -> list[str]:
     """What makes a hierarchy invalid: children outside their parent, overlapping siblings,
     negative sizes.  Retargeting results are checked with this too."""
@@ -299,13 +341,25 @@ def check(root: Box, eps: float = EPS) -> list[str]:
         if len(box.children) > 1:
             lo = np.array([c.lo for c in box.children])
             hi = np.array([c.hi for c in box.children])
-            # overlap of every pair on every axis, more than eps
-            over = np.minimum(hi[:, None], hi[None]) - np.maximum(lo[:, None], lo[None])
-            both = np.all(over > eps, axis=2)
-            for i, j in zip(*np.nonzero(np.triu(both, 1)), strict=True):
+            for i, j in overlapping(lo, hi, eps):
                 a, b = box.children[i], box.children[j]
                 problems.append(f"boxes '{a.id}' and '{b.id}' overlap")
     return problems
+
+
+def overlapping(lo: np.ndarray, hi: np.ndarray, eps: float = EPS) -> Iterator[tuple[int, int]]:
+    """Pairs i < j of boxes overlapping by more than ``eps`` on every axis, in order of i then
+    j; compared a block of rows at a time, so memory stays PAIRS_AT_ONCE, not n x n."""
+    n = len(lo)
+    rows = max(1, PAIRS_AT_ONCE // max(n, 1))
+    for start in range(0, n, rows):
+        stop = min(start + rows, n)
+        top = np.minimum(hi[start:stop, None], hi[None])
+        over = top - np.maximum(lo[start:stop, None], lo[None])
+        i, j = np.nonzero(np.all(over > eps, axis=2))
+        i += start
+        keep = i < j
+        yield from zip(i[keep].tolist(), j[keep].tolist(), strict=True)
 
 
 def uncovered(box: Box, eps: float = EPS) -> float:

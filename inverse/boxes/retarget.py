@@ -27,18 +27,20 @@ fitted (:mod:`.repair`).
 from __future__ import annotations
 
 import math
-from bisect import bisect_left
+from bisect import bisect_left, bisect_right
 from collections.abc import Sequence as Seq
 
 import numpy as np
 
 from bgr.grammar.errors import BgrError, Diagnostic
+from bgr.interpreter.limits import check_memory
 
 from .analysis import Analysis, Sequence, Unit, analyse, min_length
-from .model import AXES, EPS, Box
+from .model import AXES, EPS, MAX_BOXES, Box
 from .repair import RHO, Layout, Placed, fit, fits, valid
 
-MAX_BOXES = 200_000  # a retargeting making more is refused: a size asked by mistake (~1 GB)
+BOX_BYTES = 1000  # what a copy of a box costs (625 bytes measured) and its place in the output
+LOOK_EVERY = 2000  # boxes made between two looks at the process's memory (--max-memory)
 NUDGE = 1e-9  # floor(x + NUDGE): 2.9999999999 repeats are 3 (the grammar writes the same)
 
 
@@ -109,6 +111,7 @@ class Retargeter:
         self.taken = {b.id for b in root.walk()}  # the input's ids: a copy gets a fresh one
         self.copied: dict[str, int] = {}  # source id -> the last copy number its ids used
         self.boxes = len(self.taken)  # boxes in the result so far
+        self.look_at = self.boxes + LOOK_EVERY  # the count at which memory is measured next
 
     # ---- alignment ---------------------------------------------------------------------
     def group(self, position: float) -> int | None:
@@ -205,6 +208,12 @@ class Retargeter:
                     "ask a smaller size, or raise --max-boxes",
                 )
             )
+        if self.boxes >= self.look_at:  # the copies are what grows: held to --max-memory
+            check_memory(
+                f"retargeting along {AXES[self.axis]} ({self.boxes:,} boxes)",
+                BOX_BYTES * size * (p.count - 1),  # before they are made
+            )
+            self.look_at = self.boxes + LOOK_EVERY
         copies[i] = [self.replicate(kids[i], c * step, c) for c in range(1, p.count)]
 
     def replicate(self, box: Box, by: float, number: int) -> Box:
@@ -504,10 +513,14 @@ def analyse_groups(root: Box, axis: int) -> list[list[tuple[Box, int]]]:
 
     groups = alignment_groups(root, axis)
     out: list[list[tuple[Box, int]]] = [[] for _ in groups]
-    index = {g: k for k, g in enumerate(groups)}
+    # the groups by position: a face looks at the few near it, not at every group
+    positions = [p for p, _ in groups.values()]  # the k-th group's (dict order, as out)
+    order = sorted(range(len(positions)), key=positions.__getitem__)
+    at = [positions[k] for k in order]
     for leaf in root.leaves():
-        for side, where in ((0, leaf.lo[axis]), (1, leaf.hi[axis])):
-            for g, (p, _) in groups.items():
-                if abs(p - where) <= EPS:
-                    out[index[g]].append((leaf, side))
+        for side, where in ((0, float(leaf.lo[axis])), (1, float(leaf.hi[axis]))):
+            near = order[bisect_left(at, where - 2 * EPS) : bisect_right(at, where + 2 * EPS)]
+            for k in sorted(near):
+                if abs(positions[k] - where) <= EPS:
+                    out[k].append((leaf, side))
     return out

@@ -48,11 +48,14 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.spatial import cKDTree
 
+from bgr.interpreter.limits import check_memory
+
 # a triangle whose |ab x ac| is below this fraction of its longest edge squared is degenerate:
 # it is measured as its three edges (its height is then under 1e-10 of its size)
 FLAT = 1e-10
 CELL = 1.4  # grid cell side, in units of the side of a square of a triangle's mean area
 SPAN = 4  # a piece's bounding box spans at most this many grid cells a side
+ENTRY_BYTES = 40  # what one (cell, piece) pair of a _Grid costs while it is built
 MAX_ENTRIES = 16  # (cell, piece) pairs per triangle at most; coarser cells beyond
 THREADS = min(2, os.cpu_count() or 1)  # chunks measured at once (each holds CHUNK_PAIRS)
 CHUNK_POINTS = 500_000  # samples whose ball leaves their cell, taken a block at a time
@@ -329,6 +332,8 @@ class _Grid:
             if entries <= MAX_ENTRIES * max(len(triangles), 1024):
                 break
             cell *= 1.5  # many thin pieces spanning many cells: coarser cells
+        # the (cell, piece) pairs below: five arrays of 8 bytes an entry while they are sorted
+        check_memory("measuring distances", entries * ENTRY_BYTES)
         self.cell = cell
         self.count = len(pieces)
         self.span = last.max(axis=0) + 1

@@ -18,12 +18,15 @@ from tqdm import tqdm
 
 from bgr.grammar import nodes as n
 from bgr.grammar.errors import BgrError
+from bgr.interpreter.limits import check_memory, restart_memory
 
 from . import emit, tree
 from .components import Component, fit
 from .cuts import cut_heights, slabs
 from .model import CityScene
 from .types import Level, Types, cluster, level_for
+
+READ_COST = 10  # memory per byte of a text city file (OBJ, CityJSON) read, at least (20 measured)
 
 
 @dataclass
@@ -69,8 +72,26 @@ class CityGrammar:
     stats: list[dict] = field(default_factory=list)
 
 
+class _Bar(tqdm):
+    """A phase's progress bar that also holds the phase to the memory ceiling (--max-memory,
+    :func:`bgr.interpreter.limits.check_memory`): every phase of a long run updates one."""
+
+    EVERY = 64  # updates between two looks at the process's memory (a look: ~10 us)
+
+    def __init__(self, *args, step: str = "", **kwargs) -> None:
+        self.step, self.looks = step, 0  # a disabled tqdm keeps no desc
+        super().__init__(*args, **kwargs)
+
+    def update(self, n: float | None = 1) -> bool | None:
+        self.looks += 1
+        if self.looks % self.EVERY == 1:
+            check_memory(self.step)
+        return super().update(n)
+
+
 def _bar(options: Options, total: int, what: str) -> tqdm:
-    return tqdm(
+    return _Bar(
+        step=what,
         total=total,
         desc=what,
         unit="",
@@ -291,6 +312,17 @@ def glb_bytes(vertices: np.ndarray, faces: np.ndarray) -> bytes:
     return bytes(out) if not isinstance(out, bytes) else out
 
 
+def _reading_cost(path: str | Path) -> int:
+    """The memory reading a city file takes, at least: READ_COST times its size (0 when it
+    cannot be seen: the reader says why)."""
+    try:
+        size = Path(path).stat().st_size
+    except (OSError, ValueError):
+        return 0
+    text = str(path).lower().endswith((".obj", ".json", ".jsonl"))
+    return size * (READ_COST if text else 1)
+
+
 def infer_city(
     path: str | Path, options: Options | None = None, *, stats: bool = False
 ) -> CityGrammar:
@@ -298,7 +330,10 @@ def infer_city(
     options = options or Options()
     from .read import read_city
 
+    restart_memory()  # the ceiling (--max-memory) counts from here, the modules loaded
+    check_memory("reading the city", _reading_cost(path))
     scene = read_city(path, up=options.up)
+    check_memory("reading the city")
     comps = decompose(scene, options)
     if not comps and not scene.objects:
         raise BgrError(f"{path}: no buildings to proceduralize")
@@ -315,6 +350,7 @@ def infer_city(
             )
     level = level_for(types, level=options.level, threshold=options.threshold)
     placed = place(scene, comps, types, level, options)
+    check_memory("placing components")
     return build(scene, comps, types, placed, options)
 
 

@@ -6,8 +6,9 @@ One public function, :func:`read_city`.  Every format goes through the same step
    city objects, OBJ ``o`` objects (else ``g`` groups), the nodes of a glTF scene.  Inputs
    without objects (a PLY, an OBJ of bare faces, a glTF of one node) are cut into connected
    components, merged where their ground-plane boxes overlap (:func:`components`).
-2. **Check** what no later step can use: coordinates that are not finite numbers, an empty
-   scene.  Triangles that repeat a vertex are dropped without a word: exporters write them.
+2. **Check** what no later step can use: coordinates that are not finite numbers or lie
+   beyond 1e8 m (:mod:`.coordinates`), an empty scene.  Triangles that repeat a vertex are
+   dropped without a word: exporters write them.
 3. **Orient and re-centre**: the up axis (:func:`up_axis`), an offset of whole metres so that
    projected coordinates (hundreds of kilometres) become small (:func:`offset_of`), then the turn
    into bgr's y-up frame (:meth:`CityScene.from_input`), in float64.
@@ -30,6 +31,7 @@ import numpy as np
 from bgr.grammar.errors import BgrError, Diagnostic
 from bgr.grammar.paths import read_input
 
+from .coordinates import Locate, check_coordinates
 from .model import CityObject, CityScene
 
 if TYPE_CHECKING:
@@ -159,6 +161,7 @@ class Found:
     objects: list[CityObject] = field(default_factory=list)
     crs: str | None = None
     hint: str | None = None  # what to say when no triangles are left
+    locate: Locate | None = None  # a bad vertex's error at its place in the file (OBJ: line)
 
 
 def _template(name: str, kind: str = "object", **more) -> CityObject:
@@ -180,13 +183,10 @@ def _scene(shown: str, found: Found, up: str) -> CityScene:
         if hint is None and len(keep):
             hint = f"each of its {len(keep)} faces repeats a vertex: none has an area"
         raise BgrError(Diagnostic(shown, 0, 0, f"no triangles in {shown}", hint))
+    check_coordinates(shown, vertices, faces, owner, found.objects, found.locate)
     mark = np.zeros(len(vertices), dtype=bool)
     mark[faces] = True
     used = vertices[mark]
-    if not np.isfinite(used).all():
-        raise BgrError(
-            Diagnostic(shown, 0, 0, "a coordinate is not a finite number (NaN or infinity)")
-        )
     up = up_axis(used) if up == "auto" else up
     scene = CityScene([], shown, up, offset_of(used, up), found.crs)
     local = scene.from_input(vertices)
@@ -415,7 +415,11 @@ def _read_obj(shown: str, data: bytes) -> Found:
     faces, polygon = triangulate(vertices, parsed.sizes, corners)
     colors = None if rgb is None else _face_colors(rgb, faces)
     owner, objects = _obj_objects(obj, f_lines[polygon])
-    return Found(vertices, faces, colors, owner, objects)
+
+    def locate(vertex: int, axis: int, message: str, hint: str) -> BgrError:
+        return obj.error(int(v_lines[vertex]), axis + 1, message, hint)
+
+    return Found(vertices, faces, colors, owner, objects, locate=locate)
 
 
 def _obj_numbers(obj: ObjText, v_lines: np.ndarray, f_lines: np.ndarray) -> ObjParse:

@@ -23,6 +23,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from bgr.grammar.errors import BgrError, Diagnostic, read_json
+from bgr.interpreter.limits import MAX_INPUT_COORDINATE
 
 from .model import Block, Cell, Face, Model, default_fixed
 
@@ -88,16 +89,22 @@ def _error(path: str, message: str, hint: str | None = None) -> BgrError:
 
 
 def _vector(value, n: int, where: str, path: str) -> tuple:
+    """``n`` numbers, each finite and within MAX_INPUT_COORDINATE (a terminal at 1e308 is no
+    place: it made a lot of 1e308 that the check of the inferred grammar blamed on bgr)."""
     if (
         not isinstance(value, list)
         or len(value) != n
         or not all(
-            isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v)
+            isinstance(v, (int, float))
+            and not isinstance(v, bool)
+            and abs(v) <= MAX_INPUT_COORDINATE  # NaN compares false
             for v in value
         )
     ):
         raise _error(
-            path, f"{where} must be a list of {n} finite numbers, got {json.dumps(value)[:60]}"
+            path,
+            f"{where} must be a list of {n} finite numbers within ±{MAX_INPUT_COORDINATE:.0e} m, "
+            f"got {json.dumps(value)[:60]}".replace("e+0", "e"),
         )
     return tuple(float(v) for v in value)
 
