@@ -211,10 +211,13 @@ def derive_lots(
     else:
         results = _on_pool(job, batches, workers, window)
     shapes = triangles = 0
-    for result in results:
-        shapes += result.shapes
-        triangles += result.triangles
-        yield _checked(job, result, shapes, triangles)
+    try:
+        for result in results:
+            shapes += result.shapes
+            triangles += result.triangles
+            yield _checked(job, result, shapes, triangles)
+    finally:
+        results.close()  # a failed lot stops the workers now, not when the generator is collected
 
 
 def _serial(job: Job, numbered: Iterator[tuple[int, Lot]]) -> Iterator[LotResult]:

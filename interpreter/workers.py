@@ -207,8 +207,9 @@ class Pool:
                 worker.process.kill()
         for worker in self._workers:
             worker.process.join()
-            worker.tasks.close()
-            worker.alive.close()
+            for end in (worker.tasks, worker.alive):
+                with contextlib.suppress(OSError):  # closed already at interpreter exit
+                    end.close()
         self._workers = []
 
 
