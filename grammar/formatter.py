@@ -331,6 +331,8 @@ class Formatter:
             return False
         if self.has_comment_inside(body.pos) or self.has_comment_on_line(body.pos.end_line):
             return False  # comments keep the rule on one line, so that fmt(fmt(x)) == fmt(x)
+        if len(head) + 4 * len(steps) > self.width:  # each `[ ]` and a space: too long, unwritten
+            return True
         return len(head) + 1 + len(self.inline_steps(steps)) > self.width
 
     def alt_head(self, alt) -> str:

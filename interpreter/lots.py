@@ -22,18 +22,16 @@ from pathlib import Path
 import numpy as np
 import shapely
 from shapely.geometry import Polygon
-from shapely.validation import make_valid
 
 from bgr.grammar.errors import BgrError, Diagnostic, HeldWarnings, Warnings, read_json
 
-from .geometry.earclip import signed_area as ring_area
 from .geometry.polygons import RECT, is_unit_square, normalise, signed_area
+from .outline import CLEAN_TOL, FootprintError, clean_ring
+from .outline import lengths as _lengths
 from .shapes import IDENTITY, Flat, Shape
 from .values import MAX_COORDINATE, is_number, number_of, number_problem
 
 DEFAULT_LOT = (20.0, 20.0)
-CLEAN_TOL = 1e-3  # metres: a corner this close to the previous one or to a straight line goes
-MIN_WIDTH = 0.05  # metres: an outline whose mean width (2 area / perimeter) is less is skipped
 
 # GeoJSON's own CRS (RFC 7946): longitude, latitude on WGS84
 CRS84 = "OGC:CRS84"
@@ -53,10 +51,6 @@ class Lot:
     # attr -> value that --map gave this lot from its properties, coerced at read time (see
     # PropertyMap); attr_overrides applies them over the properties of the attrs' own names
     mapped: dict = field(default_factory=dict)
-
-
-class FootprintError(ValueError):
-    """A feature's outline cannot be a lot; the message says why (it follows "skipped: ")."""
 
 
 # --------------------------------------------------------------------------------------------
@@ -848,110 +842,6 @@ def _crs_name(crs) -> str | None:
     no output file could name either."""
     authority = crs.to_authority()
     return f"{authority[0]}:{authority[1]}" if authority else None
-
-
-# --------------------------------------------------------------------------------------------
-# cleaning one outline
-
-
-def clean_ring(ring) -> tuple[np.ndarray, str | None]:
-    """A footprint outline (k, 2) in metres made fit to build on, and a note when that lost
-    part of it; raises FootprintError when nothing usable is left.
-
-    - the closing point and corners within CLEAN_TOL of the previous one are dropped;
-    - an outline that crosses or touches itself is repaired with shapely's ``make_valid`` and
-      the largest polygon it yields is kept (the note says how much was dropped), without any
-      hole the repair makes (the input's own holes are rings of their own: see _clean_holes);
-    - corners within CLEAN_TOL of the straight line through their neighbours are dropped;
-    - an outline whose mean width (2 area / perimeter) is under MIN_WIDTH is not used.
-
-    The first edge (the front) stays the one that carries the input's first edge; a repaired
-    outline starts at its corner nearest the input's first corner and keeps its orientation.
-    """
-    pts = _drop_repeats(np.asarray(ring, dtype=np.float64))
-    if len(pts) < 3:
-        raise FootprintError("its outline has fewer than three distinct corners")
-    note = None
-    poly = Polygon(pts)
-    if not poly.is_valid:
-        pts, note = _repair(pts, poly)
-    kept = _drop_straight(pts)
-    if len(kept) >= 3 and Polygon(pts[kept]).is_valid:
-        # the front edge is the kept edge that carries input edge 0: start at the last kept
-        # corner at or before corner 0 (cyclically)
-        start = kept.index(0) if 0 in kept else len(kept) - 1
-        pts = pts[kept[start:] + kept[:start]]
-    area, perimeter = abs(ring_area(pts)), float(_lengths(pts).sum())
-    if area == 0 or 2 * area / perimeter < MIN_WIDTH:
-        raise FootprintError(
-            "its outline has no area"
-            if area < 1e-6
-            else f"its outline is thinner than {MIN_WIDTH * 100:g} cm ({area:.2g} m²)"
-        )
-    return pts, note
-
-
-def _lengths(pts: np.ndarray) -> np.ndarray:
-    return np.linalg.norm(np.roll(pts, -1, axis=0) - pts, axis=1)
-
-
-def _drop_repeats(pts: np.ndarray) -> np.ndarray:
-    """The ring without its closing point and without corners within CLEAN_TOL of the one
-    before (a corner is compared with the last one kept, so a run of near-repeats is one)."""
-    kept = [0]
-    for i in range(1, len(pts)):
-        if np.linalg.norm(pts[i] - pts[kept[-1]]) > CLEAN_TOL:
-            kept.append(i)
-    while len(kept) > 1 and np.linalg.norm(pts[kept[-1]] - pts[kept[0]]) <= CLEAN_TOL:
-        kept.pop()
-    return pts[kept]
-
-
-def _drop_straight(pts: np.ndarray) -> list[int]:
-    """Indices of the corners that are not within CLEAN_TOL of the straight line through their
-    neighbours (lying between them); repeated until none is left, so a run of them goes."""
-    keep = list(range(len(pts)))
-    changed = True
-    while changed and len(keep) > 3:
-        changed = False
-        a, b, c = pts[np.roll(keep, 1)], pts[keep], pts[np.roll(keep, -1)]
-        ac = c - a
-        span = np.linalg.norm(ac, axis=1)
-        off = np.abs(ac[:, 0] * (b - a)[:, 1] - ac[:, 1] * (b - a)[:, 0]) / np.maximum(span, 1e-300)
-        between = np.einsum("ij,ij->i", b - a, c - b) > 0
-        straight = np.flatnonzero((span > CLEAN_TOL) & (off <= CLEAN_TOL) & between)
-        if len(straight):
-            del keep[int(straight[np.argmin(off[straight])])]  # the straightest first
-            changed = True
-    return keep
-
-
-def _repair(pts: np.ndarray, poly: Polygon) -> tuple[np.ndarray, str | None]:
-    """The largest polygon ``make_valid`` makes of a self-crossing outline, as a ring in the
-    input's orientation starting at the corner nearest the input's first one."""
-    fixed = make_valid(poly)
-    parts = [
-        g
-        for g in shapely.get_parts(fixed)
-        for g in (shapely.get_parts(g) if g.geom_type == "GeometryCollection" else [g])
-        if g.geom_type in ("Polygon", "MultiPolygon")
-    ]
-    polygons = [p for g in parts for p in shapely.get_parts(g) if p.area > 0]
-    if not polygons:
-        raise FootprintError("its outline has no area")
-    best = max(polygons, key=lambda p: p.area)
-    ring = np.array(best.exterior.coords[:-1], dtype=np.float64)
-    if (ring_area(ring) > 0) != (ring_area(pts) > 0):
-        ring = ring[::-1]
-    ring = np.roll(ring, -int(np.argmin(np.linalg.norm(ring - pts[0], axis=1))), axis=0)
-    note = None
-    if len(polygons) > 1:
-        total = sum(p.area for p in polygons)
-        note = (
-            f"its outline crosses itself; repaired, keeping the largest of its {len(polygons)} "
-            f"parts ({best.area:.3g} of {total:.3g} m²)"
-        )
-    return _drop_repeats(ring), note
 
 
 # --------------------------------------------------------------------------------------------

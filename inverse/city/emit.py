@@ -56,22 +56,50 @@ def matrix(angle: float, offset: np.ndarray) -> n.Operation:
     """``matrix(...)``: a turn about the vertical by ``angle`` degrees and a translation, as the
     3x4 row-major matrix whose columns are the child's axes in the parent's frame."""
     a = np.radians(angle)
-    c, s = np.cos(a), np.sin(a)
-    rows = [[c, 0.0, s, offset[0]], [0.0, 1.0, 0.0, offset[1]], [-s, 0.0, c, offset[2]]]
-    args = [num(v, 9) if j < 3 else num(v) for row in rows for j, v in enumerate(row)]
-    return n.Operation("matrix", list(args))
+    return _matrix(float(np.cos(a)), float(np.sin(a)), [float(v) for v in offset[:3]])
+
+
+def _matrix(c: float, s: float, offset: list[float]) -> n.Operation:
+    """:func:`matrix` from the turn's cosine and sine and the offset, as Python floats."""
+    cos, sin, minus_sin = _num(c, 9), _num(s, 9), _num(-s, 9)
+    args = [cos, n.Number(0.0), sin, _num(offset[0], 6)]
+    args += [n.Number(0.0), n.Number(1.0), n.Number(0.0), _num(offset[1], 6)]
+    args += [minus_sin, n.Number(0.0), _num(c, 9), _num(offset[2], 6)]
+    return n.Operation("matrix", args)
+
+
+def _num(value: float, digits: int) -> n.Expr:
+    """:func:`num` of a Python float."""
+    value = round(value, digits)
+    if value < 0:
+        return n.Unary("-", n.Number(-value))
+    return n.Number(value if value else 0.0)  # -0.0 prints as 0
 
 
 def placement(p: Placement) -> n.Push:
-    steps: list = [matrix(p.angle, p.offset)]
-    if p.size is not None:
-        steps.append(n.Operation("s", [num(v) for v in p.size]))
-    steps.append(n.Successor(p.rule))
-    return n.Push(steps)
+    return placements([p])[0]
 
 
-def rule(name: str, placements: list[Placement]) -> n.Rule:
-    return n.Rule(name, [], n.Sequence([placement(p) for p in placements] or [n.Nil()]))
+def placements(found: list[Placement]) -> list[n.Push]:
+    """``[ matrix(...) s(...) Rule ]`` of each placement: the turns' sines and cosines of all
+    at once (a city's axiom places every building: 100,000 of them is ordinary)."""
+    if not found:
+        return []
+    a = np.radians(np.array([p.angle for p in found], dtype=np.float64))
+    cos, sin = np.cos(a).tolist(), np.sin(a).tolist()
+    offsets = np.array([p.offset[:3] for p in found], dtype=np.float64).reshape(-1, 3).tolist()
+    out = []
+    for p, c, s, offset in zip(found, cos, sin, offsets, strict=True):
+        steps: list = [_matrix(c, s, offset)]
+        if p.size is not None:
+            steps.append(n.Operation("s", [num(v) for v in p.size]))
+        steps.append(n.Successor(p.rule))
+        out.append(n.Push(steps))
+    return out
+
+
+def rule(name: str, found: list[Placement]) -> n.Rule:
+    return n.Rule(name, [], n.Sequence(placements(found) or [n.Nil()]))
 
 
 def module(

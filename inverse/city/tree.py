@@ -26,6 +26,8 @@ from dataclasses import dataclass, field
 
 import networkx as nx
 import numpy as np
+from scipy.sparse import coo_matrix
+from scipy.sparse.csgraph import connected_components
 from scipy.spatial import cKDTree
 
 GN_MAX_NODES = 60  # more kinds than this in one connected part: Louvain first (see above)
@@ -81,6 +83,13 @@ def relative(parent: np.ndarray, child: np.ndarray) -> tuple[float, np.ndarray]:
     return turn_of(rel), rel[:3, 3]
 
 
+def relative_all(parent: np.ndarray, children: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`relative` of many children at once (``parent`` one frame or one per child):
+    angles (n,) and offsets (n, 3), the same numbers (stacked products compute each alone)."""
+    rel = np.linalg.inv(parent) @ children
+    return np.degrees(np.arctan2(-rel[:, 2, 0], rel[:, 0, 0])), rel[:, :3, 3]
+
+
 def _grid(level: int) -> tuple[float, float]:
     """(metres, degrees) grids on which placements must agree to share a rule: 0.1 mm and 1e-5
     degrees at the exact level 0 (errors well under 1 mm), coarser above."""
@@ -96,6 +105,25 @@ def _key(p: Placement, grid: tuple[float, float]) -> tuple:
     offset = tuple(np.rint(p.offset / metres).astype(np.int64).tolist())
     size = () if p.size is None else tuple(np.rint(p.size / metres).astype(np.int64).tolist())
     return (p.rule, angle, offset, size)
+
+
+def keys_all(
+    rank: np.ndarray,
+    angles: np.ndarray,
+    offsets: np.ndarray,
+    sizes: np.ndarray | None,
+    grid: tuple[float, float],
+) -> np.ndarray:
+    """:func:`_key` of many placements as rows of ints (n, 5 or 8): the rule's rank among the
+    rule names (so that rows sort as the keys do), the angle, the offset and the size on the
+    grid."""
+    metres, degrees = grid
+    angle = np.rint(np.remainder(angles, 360.0) / degrees).astype(np.int64)
+    columns = [rank[:, None], (angle % int(np.rint(360.0 / degrees)))[:, None]]
+    columns.append(np.rint(offsets / metres).astype(np.int64))
+    if sizes is not None:
+        columns.append(np.rint(sizes / metres).astype(np.int64))
+    return np.concatenate(columns, axis=1)
 
 
 def _average(placements: list[list[Placement]]) -> list[Placement]:
@@ -133,6 +161,8 @@ def kind_graph(
     count = np.bincount(kinds)
     a, b = kinds[pairs[:, 0]], kinds[pairs[:, 1]]
     keep = a != b
+    if not keep.any():  # only buildings of one kind near each other: no edge between kinds
+        return graph
     pairs, a, b = pairs[keep], a[keep], b[keep]
     if len(pairs) == 0:  # every neighbour is of its own kind (a street of one house)
         return graph
@@ -203,49 +233,131 @@ def group(
     pairs = cKDTree(mid).query_pairs(tau, output_type="ndarray")
     if len(pairs) == 0:
         return pool
-    graph = nx.Graph()
-    graph.add_nodes_from(range(len(pool)))
-    graph.add_edges_from(pairs.tolist())
     by_signature: dict[tuple, list[tuple[list[int], list[Placement], np.ndarray]]] = defaultdict(
         list
     )
     out: list[Instance] = []
-    for members in sorted((sorted(c) for c in nx.connected_components(graph)), key=min):
+    parts = _connected(len(pool), pairs)
+    signed = iter(_signatures(pool, [m for m in parts if len(m) > 1], grid))
+    for members in parts:
         if len(members) == 1:
             out.append(pool[members[0]])
             continue
-        signature, ordered, placed, anchor = _signature(pool, members, grid)
+        signature, ordered, placed, anchor = next(signed)
         by_signature[signature].append((ordered, placed, anchor))
+    repeated: list[tuple[int, str, np.ndarray, list[int]]] = []
     for found in sorted(by_signature.values(), key=lambda f: min(f[0][0])):
         if len(found) < 2:
             out += [pool[i] for i in found[0][0]]
             continue
         name = new_rule(_average([placed for _, placed, _ in found]), len(found))
         for members, _, anchor in found:
-            mid = np.mean([pool[i].midpoint for i in members], axis=0)
-            out.append(Instance(name, anchor, mid))
+            repeated.append((len(out), name, anchor, members))
+            out.append(pool[members[0]])  # in its place until the midpoints are known
+    means = _means(pool, [members for *_, members in repeated])
+    for (k, name, anchor, _), mid in zip(repeated, means, strict=True):
+        out[k] = Instance(name, anchor, mid)
+    return out
+
+
+def _means(pool: list[Instance], groups: list[list[int]]) -> list[np.ndarray]:
+    """The mean midpoint of each group of instances (``np.mean`` of them in the group's order),
+    the groups of one size at a time."""
+    out: list[np.ndarray] = [np.zeros(3)] * len(groups)
+    sizes = np.array([len(g) for g in groups], dtype=np.int64)
+    for size in np.unique(sizes).tolist():
+        which = np.flatnonzero(sizes == size).tolist()
+        points = np.array([[pool[i].midpoint for i in groups[k]] for k in which])
+        for k, mean in zip(which, np.mean(points, axis=1), strict=True):
+            out[k] = mean
     return out
 
 
 ANCHORS = 8  # at most this many members are tried as an instance's anchor
 
 
-def _signature(
-    pool: list[Instance], members: list[int], grid: tuple[float, float]
-) -> tuple[tuple, list[int], list[Placement], np.ndarray]:
-    """The signature of a group of instances: its members' placements relative to an anchor
-    member, on the grid, sorted.  Each member of the first rule (by name) is tried as the anchor
-    and the smallest signature kept, so that a turned copy of a pattern has the same one."""
-    first_rule = min(pool[i].rule for i in members)
-    candidates = [i for i in members if pool[i].rule == first_rule][:ANCHORS]
-    best = None
-    for a in candidates:
-        anchor = pool[a].frame
-        placed = [Placement(pool[i].rule, *relative(anchor, pool[i].frame)) for i in members]
-        keys = [_key(p, grid) for p in placed]
-        order = sorted(range(len(members)), key=lambda j: keys[j])
-        signature = tuple(keys[j] for j in order)
-        if best is None or signature < best[0]:
-            best = (signature, [members[j] for j in order], [placed[j] for j in order], anchor)
-    assert best is not None
-    return best
+def _connected(count: int, pairs: np.ndarray) -> list[list[int]]:
+    """The connected components of the graph on ``count`` nodes with edges ``pairs``, each
+    sorted, in order of their least node."""
+    graph = coo_matrix((np.ones(len(pairs)), (pairs[:, 0], pairs[:, 1])), shape=(count, count))
+    _, label = connected_components(graph, directed=False)
+    order = np.argsort(label, kind="stable")
+    parts = np.split(order, np.flatnonzero(np.diff(label[order])) + 1)
+    return [p.tolist() for p in sorted(parts, key=lambda p: int(p[0]))]
+
+
+def _signatures(
+    pool: list[Instance], parts: list[list[int]], grid: tuple[float, float]
+) -> list[tuple[tuple, list[int], list[Placement], np.ndarray]]:
+    """The signature of each group of instances (``parts``, each sorted): its members'
+    placements relative to an anchor member, on the grid, sorted.  Each member of the group's
+    first rule (by name; at most ANCHORS of them) is tried as the anchor and the smallest
+    signature kept (the first of equals), so that a turned copy of a pattern has the same one.
+
+    All groups at once: the k-th anchors of every group are tried together (stacked inverses and
+    products, :func:`relative_all`), and each group keeps the better of its best so far and
+    its k-th.  Returns (signature, members in signature order, their placements, anchor frame)
+    for each group."""
+    if not parts:
+        return []
+    frames = np.stack([inst.frame for inst in pool])
+    names = [inst.rule for inst in pool]
+    rank = np.unique(names, return_inverse=True)[1].reshape(-1)
+    sizes = np.array([len(p) for p in parts], dtype=np.int64)
+    members = np.concatenate([np.asarray(p, dtype=np.int64) for p in parts])
+    part_of = np.repeat(np.arange(len(parts)), sizes)
+    starts = np.r_[0, np.cumsum(sizes)[:-1]]
+    own_rank = rank[members]
+    first = own_rank == np.minimum.reduceat(own_rank, starts)[part_of]  # of the first rule
+    nth = np.cumsum(first) - 1
+    nth -= np.r_[0, np.cumsum(first)[:-1]][starts][part_of]  # its place among them, per group
+    best: dict[str, np.ndarray] = {}
+    for k in range(ANCHORS):
+        anchors = members[first & (nth == k)]  # the k-th anchor of each group that has one
+        tried = np.flatnonzero(np.bincount(part_of[first & (nth == k)], minlength=len(parts)))
+        if not len(tried):
+            break
+        rows = np.flatnonzero(np.isin(part_of, tried))  # their members, group by group
+        local = np.searchsorted(tried, part_of[rows])
+        angles, offsets = relative_all(frames[anchors][local], frames[members[rows]])
+        keys = keys_all(own_rank[rows], angles, offsets, None, grid)
+        order = np.lexsort((*keys.T[::-1], local))  # each group's placements by key
+        found = {
+            "keys": keys[order],
+            "members": members[rows][order],
+            "angles": angles[order],
+            "offsets": offsets[order],
+        }
+        if k == 0:
+            best = found
+            best["anchor"] = anchors
+            continue
+        better = _less(found["keys"], best["keys"][rows], local, len(tried))
+        swap = np.isin(local, np.flatnonzero(better))
+        for name, value in found.items():
+            best[name][rows[swap]] = value[swap]
+        best["anchor"][tried[better]] = anchors[better]
+    out = []
+    for j, (s, e) in enumerate(zip(starts.tolist(), (starts + sizes).tolist(), strict=True)):
+        ordered = best["members"][s:e].tolist()
+        angles = best["angles"][s:e].tolist()
+        offsets = best["offsets"][s:e]
+        placed = [
+            Placement(names[i], a, o) for i, a, o in zip(ordered, angles, offsets, strict=True)
+        ]
+        signature = (tuple(names[i] for i in ordered), best["keys"][s:e, 1:].tobytes())
+        out.append((signature, ordered, placed, pool[int(best["anchor"][j])].frame))
+    return out
+
+
+def _less(a: np.ndarray, b: np.ndarray, group: np.ndarray, count: int) -> np.ndarray:
+    """For rows ``a`` and ``b`` (equal shapes) cut into ``count`` consecutive groups: whether
+    each group's rows in ``a`` come before its rows in ``b``, compared as tuples."""
+    flat_a, flat_b = a.reshape(-1), b.reshape(-1)
+    where = np.repeat(group, a.shape[1])
+    differ = np.flatnonzero(flat_a != flat_b)
+    out = np.zeros(count, dtype=bool)
+    first_diff = np.unique(where[differ], return_index=True)
+    at = differ[first_diff[1]]
+    out[first_diff[0]] = flat_a[at] < flat_b[at]
+    return out
