@@ -6,8 +6,6 @@ One terminal per line, keys in the order the language reference shows, floats as
 
 from __future__ import annotations
 
-import contextlib
-import gc
 import json
 import tempfile
 from collections.abc import Callable
@@ -16,6 +14,7 @@ from typing import BinaryIO, TextIO
 import numpy as np
 
 from bgr.grammar.errors import BgrError
+from bgr.grammar.parser import no_gc
 from bgr.interpreter.terminals import TerminalTable, lot_tables
 
 from .meshes import srgb8
@@ -42,22 +41,10 @@ def _dumps(value) -> str:
         raise BgrError(f"cannot write the terminal list as JSON: {exc}") from exc
 
 
-@contextlib.contextmanager
-def _no_gc():
-    """Pause the cyclic collector: it would rescan millions of fresh small lists again and again."""
-    was_on = gc.isenabled()
-    gc.disable()
-    try:
-        yield
-    finally:
-        if was_on:
-            gc.enable()
-
-
 def terminal_dicts(table: TerminalTable) -> list[dict]:
     """The ``terminals`` array as Python data, in table order."""
     table.freeze()
-    with _no_gc():
+    with no_gc():
         # adding 0.0 turns -0.0 into 0.0: same value, tidier text
         origin = (table.origin + 0.0).tolist()
         axes = (table.axes + 0.0).tolist()
@@ -125,7 +112,7 @@ class TerminalListWriter:
         )
 
     def add(self, table: TerminalTable) -> None:
-        with _no_gc():
+        with no_gc():
             rows = terminal_dicts(table)
             if rows:
                 self.write(
