@@ -15,7 +15,9 @@ import re
 import signal
 import sys
 import traceback
+from collections.abc import Callable
 from pathlib import Path
+from typing import Any
 
 from . import __version__
 from .formats.atomic import Terminated, on_sigterm, reset_termination
@@ -760,13 +762,18 @@ def _progress(lots: int, output: str):
 
 
 def cmd_infer(args) -> int:
-    """bgr infer under its memory ceiling (--max-memory; checked by the inverse modules)."""
+    return _under_ceiling(args, "infer", "infer from a smaller input", _infer)
+
+
+def _under_ceiling(args, command: str, advice: str, run: Callable[[Any], int]) -> int:
+    """``run(args)`` under the run's memory ceiling (--max-memory; the inverse modules check
+    it at their expensive steps, ``advice`` is what the message suggests)."""
     memory = memory_limit(args)
     if isinstance(memory, str):
-        print(f"bgr infer: {memory}", file=sys.stderr)
+        print(f"bgr {command}: {memory}", file=sys.stderr)
         return EXIT_USAGE
-    with memory_ceiling(memory, args.input, "infer from a smaller input"):
-        return _infer(args)
+    with memory_ceiling(memory, args.input, advice):
+        return run(args)
 
 
 def _infer(args) -> int:
@@ -939,12 +946,7 @@ def cmd_render(args) -> int:
 def cmd_retarget(args) -> int:
     from .inverse.boxes.command import run_retarget
 
-    memory = memory_limit(args)
-    if isinstance(memory, str):
-        print(f"bgr retarget: {memory}", file=sys.stderr)
-        return EXIT_USAGE
-    with memory_ceiling(memory, args.input, "ask a smaller size, or give fewer boxes"):
-        return run_retarget(args)
+    return _under_ceiling(args, "retarget", "ask a smaller size, or give fewer boxes", run_retarget)
 
 
 COMMANDS = {
