@@ -19,6 +19,7 @@ exit from :meth:`Pool.ordered` other than success the workers are killed, not as
 
 from __future__ import annotations
 
+import atexit
 import contextlib
 import os
 import signal
@@ -88,6 +89,10 @@ class Pool:
 
     def __init__(self, workers: int, context, initializer: Callable, initargs: tuple) -> None:
         self._workers: list[_Worker] = []
+        # a run interrupted outside ordered() (Ctrl-C while the caller writes a lot) leaves the
+        # generator suspended until the interpreter tears it down, after multiprocessing has
+        # closed the processes' sentinels; end the workers before that, while join still works
+        atexit.register(self.kill)
         try:
             for number in range(workers):
                 self._workers.append(_Worker(context, initializer, initargs, number + 1))
@@ -202,11 +207,12 @@ class Pool:
 
     def kill(self) -> None:
         """End every worker now (SIGKILL) and release the pipes.  Safe to call twice."""
+        atexit.unregister(self.kill)
         for worker in self._workers:
             if worker.process.exitcode is None:
                 worker.process.kill()
         for worker in self._workers:
-            worker.process.join()
+            worker.process.join(5.0)  # SIGKILL cannot be caught: bounded only for safety
             for end in (worker.tasks, worker.alive):
                 with contextlib.suppress(OSError):  # closed already at interpreter exit
                     end.close()
