@@ -330,6 +330,22 @@ def test_boxes_cannot_inject_grammar(tmp_path, capsys):
         assert boxes_case(tmp_path, stem, "porch", "porch.obj", capsys, benign) is not None
 
 
+def test_retarget_refuses_a_mesh_path_no_file_has(tmp_path, capsys):
+    source = tmp_path / "boxes.json"
+    source.write_text(json.dumps(boxes_doc("porch", "\ud800.obj")))
+    code, err = run(["retarget", source, "--size", "12,10,10", "-o", tmp_path / "r.json"], capsys)
+    assert code == 1 and "boxes.json: error: " in err and "\\ud800" in err, err
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["boxes.json"]
+
+
+def test_an_assets_folder_a_grammar_cannot_name_is_refused(tmp_path, capsys):
+    source = tmp_path / "city.obj"
+    source.write_text(obj_text("house"))
+    code, err = run(["infer", source, "-o", tmp_path / "\udcff.bgr"], capsys)
+    assert code == 2 and "--assets DIR" in err and "internal error" not in err, err
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["city.obj"]
+
+
 def test_a_box_mesh_path_is_a_string_literal(tmp_path, capsys):
     mesh = 'a"\\b\n#c -->{}.obj'
     text = boxes_case(tmp_path, "boxes", "porch", mesh, capsys, None)
@@ -365,10 +381,24 @@ def _set_everywhere(doc: dict, key: str, value: str) -> None:
             stack += item
 
 
-@pytest.mark.slow
-def test_captured_models_cannot_inject_grammar(tmp_path, capsys):
+def test_captured_model_names_and_file_names_cannot_inject_grammar(tmp_path, capsys):
     benign = captured_case(tmp_path, "shop", lambda d: None, capsys, None)
     assert benign is not None
+    for stem in (EVIL_FILE, FILE_PAYLOAD, "\udcff"):
+        text = captured_case(tmp_path, stem, lambda d: None, capsys, benign)
+        assert text is not None
+    for key in ("name", "id"):
+        twin = captured_case(
+            tmp_path, "shop", lambda d, k=key: _set_everywhere(d, k, "w"), capsys, None
+        )
+        assert captured_case(
+            tmp_path, "shop", lambda d, k=key: _set_everywhere(d, k, PAYLOAD), capsys, twin
+        )
+
+
+@pytest.mark.slow
+def test_captured_models_cannot_inject_grammar(tmp_path, capsys):
+    """Every text field of a captured model, every hostile name (about 20 s)."""
     for key in ("name", "id", "label", "plain", "roof"):
         # the same edit with plain words: names told apart as the hostile ones are
         twin = captured_case(
@@ -380,9 +410,6 @@ def test_captured_models_cannot_inject_grammar(tmp_path, capsys):
                 _set_everywhere(doc, key, name)
 
             captured_case(tmp_path, "shop", edit, capsys, twin)
-    for stem in (EVIL_FILE, FILE_PAYLOAD, "\udcff"):
-        text = captured_case(tmp_path, stem, lambda d: None, capsys, benign)
-        assert text is not None
 
 
 def terminal_list(tmp_path: Path, capsys) -> dict:
