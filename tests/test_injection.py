@@ -21,6 +21,8 @@ from collections import Counter
 from pathlib import Path
 
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from bgr.cli import main
 from bgr.grammar import nodes as n
@@ -107,6 +109,17 @@ def test_comment_text_is_one_printable_line_of_bounded_length(value):
         assert safe == value  # printable text is kept as it is
 
 
+@settings(max_examples=300, deadline=None)
+@given(st.text(), st.text())
+def test_any_text_in_a_comment_or_a_name_leaves_the_grammar_as_it_is(comment, name):
+    """Whatever the input holds (any code points, surrogates included), the comment and the
+    rule name built from it parse to one comment and one rule."""
+    rule = identifier(name)
+    text = f"{comment_line('# ' + comment_text(comment))}\n{rule} --> NIL\n"
+    assert parse(text).items == [n.Rule(rule, [], n.Sequence([n.Nil()]))]
+    text.encode("utf-8")  # writable as it is
+
+
 def test_comment_line_keeps_parsed_comments_and_mends_built_ones():
     for parsed in ("# a\ttab", "// x \u2028 y", "#"):
         assert comment_line(parsed) == parsed
@@ -138,6 +151,18 @@ def test_the_formatter_never_writes_a_built_comment_as_code():
     )
     text = format_module(module)
     assert shape(text) == Counter({"Attr": 1, "attr width": 1})
+
+
+@settings(max_examples=300, deadline=None)
+@given(st.text())
+def test_any_built_comment_stays_a_comment(text):
+    """The formatter's own guard: a comment a module built holds any text and stays one."""
+    module = n.Module(
+        [n.Attr("width", n.Number(1.0), pos=n.Pos(2, 1, 2, 2))],
+        comments=[n.Comment(text, 1, 1, True)],
+        source="#\nx\n",
+    )
+    assert parse(format_module(module)).items == module.items
 
 
 def test_a_long_rule_name_without_parameters_stays_on_one_line():
