@@ -24,6 +24,7 @@ from dataclasses import dataclass
 
 from . import nodes as n
 from .errors import BgrError, Diagnostic, source_lines
+from .safe_text import comment_line
 
 WIDTH = 100
 HEAD_WIDTH = (
@@ -217,7 +218,13 @@ class Formatter:
     def __init__(self, module: n.Module, width: int = WIDTH) -> None:
         self.module = module
         self.width = width
-        self.comments = sorted(module.comments, key=lambda c: (c.line, c.column))
+        # a comment a module built (bgr infer) stays one comment, whatever its text holds
+        self.comments = [
+            c
+            if c.text == (safe := comment_line(c.text))
+            else n.Comment(safe, c.line, c.column, c.own_line)
+            for c in sorted(module.comments, key=lambda c: (c.line, c.column))
+        ]
         self.comment_keys = [(c.line, c.column) for c in self.comments]
         self.source_lines = source_lines(module.source) if module.source else []
 
@@ -271,7 +278,7 @@ class Formatter:
 
     def rule(self, rule: n.Rule, out: _Writer) -> None:
         head = rule.name + format_params(rule) + " -->"
-        if len(head) > HEAD_WIDTH:  # a long parameter list: one parameter per line
+        if len(head) > HEAD_WIDTH and rule.params:  # a long parameter list: one a line
             out.write(rule.name + "(")
             for i, p in enumerate(rule.params):
                 out.start(rule.pos.line, 1)

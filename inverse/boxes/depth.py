@@ -12,6 +12,7 @@ from __future__ import annotations
 
 from bgr.grammar import nodes as n
 from bgr.grammar.errors import Diagnostic
+from bgr.grammar.safe_text import comment_text
 from bgr.interpreter.limits import DEFAULT_MAX_DEPTH
 
 from .model import EPS, Box
@@ -69,8 +70,7 @@ def deep_message(depth: int | None) -> Diagnostic:
 
 def shown(text: str, most: int = 60) -> str:
     """An id as a message shows it: control characters escaped, at most ``most`` characters."""
-    safe = "".join(c if c.isprintable() else repr(c)[1:-1] for c in text[: most + 1])
-    return safe[:most] + "..." if len(text) > most else safe
+    return comment_text(text, most)  # the same escaping as the grammar's comments
 
 
 def rule_depth(module: n.Module) -> int:

@@ -26,7 +26,7 @@ from pathlib import Path
 
 from bgr.grammar import nodes as n
 from bgr.grammar.errors import BgrError
-from bgr.grammar.registry import BUILTIN_NAMES, KEYWORDS, OPERATIONS
+from bgr.grammar.safe_text import RESERVED, identifier, unwritable
 
 from .analysis import min_length
 from .depth import MAX_DEPTH, deep_message, nesting, rule_depth, too_deep
@@ -35,12 +35,7 @@ from .depth import shown as _shown
 from .model import AXES, EPS, Box
 
 ATTRS = ("width", "height", "length")  # x, y, z ('depth' is the derivation depth in .bgr)
-_RESERVED = (
-    set(OPERATIONS)
-    | set(KEYWORDS)
-    | set(BUILTIN_NAMES)
-    | {"NIL", "true", "false", "and", "or", "not", "case", "else", "Lot"}
-)
+_RESERVED = set(RESERVED) | {"Lot"}
 _NUDGE = 0.000000001
 
 
@@ -141,29 +136,26 @@ class _Writer:
     def fresh(self, base: str) -> str:
         words = [w for w in re.split(r"[^A-Za-z0-9]+", base) if w and not w.isdigit()]
         words = [w.rstrip("0123456789") or w for w in words]
-        name = "".join(w[0].upper() + w[1:] for w in words)[:_NAME_LENGTH] or "Part"
-        if not name[0].isalpha():
-            name = "B" + name
-        out, i = name, 2
-        while out in self.taken:
-            out, i = f"{name}{i}", i + 1
+        camel = "".join(w[0].upper() + w[1:] for w in words)
+        out = identifier(camel, "Part", prefix="B", most=_NAME_LENGTH, taken=self.taken)
         self.taken.add(out)
         return out
 
     def asset(self, mesh: str) -> str:
         if mesh not in self.assets:
+            if unwritable(mesh):  # checked before the path is: the system cannot take it either
+                raise BgrError(
+                    f"mesh '{_shown(mesh)}' holds {unwritable(mesh)}, which a grammar "
+                    "(UTF-8 text) cannot hold: rename the file"
+                )
             try:
                 full = (self.base / mesh).resolve()
             except OSError as e:  # a name longer than the system takes
                 raise BgrError(f"mesh '{_shown(mesh)}' is not a path: {e.strerror}") from None
             path = Path(os.path.relpath(full, self.out_dir.resolve()))
-            stem = re.sub(r"[^A-Za-z0-9_]", "_", Path(mesh).stem).strip("_").lower()
-            stem = stem[:_NAME_LENGTH] or "part"
-            if not stem[0].isalpha():
-                stem = "m_" + stem
-            name, i = stem, 2
-            while name in self.taken:
-                name, i = f"{stem}_{i}", i + 1
+
+            stem = Path(mesh).stem.lower()
+            name = identifier(stem, "part", prefix="m_", sep="_", taken=self.taken)
             self.taken.add(name)
             self.assets[mesh] = n.Asset(name, path.as_posix())
         return self.assets[mesh].name

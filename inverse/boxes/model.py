@@ -19,6 +19,7 @@ import numpy as np
 
 from bgr.grammar.errors import BgrError, Diagnostic
 from bgr.grammar.paths import read_input
+from bgr.grammar.safe_text import unwritable
 
 AXES = "xyz"
 BEHAVIOURS = ("S", "R", "F")
@@ -295,6 +296,8 @@ def _path_problem(mesh: str) -> str | None:
     """What makes ``mesh`` no file path the system takes (a NUL, too long), or None."""
     if "\0" in mesh:
         return "a NUL character"
+    if unwritable(mesh):  # a lone surrogate ("\ud800" in the JSON): no file name, no grammar text
+        return unwritable(mesh)
     if len(mesh) > MESH_PATH:
         return f"{len(mesh):,} characters"
     longest = max(

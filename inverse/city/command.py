@@ -7,6 +7,7 @@ import sys
 from pathlib import Path
 
 from bgr.grammar.errors import BgrError
+from bgr.grammar.safe_text import comment_text, unwritable
 
 from .components import FEATURES
 from .pipeline import Options, infer_city, level_stats, to_text, write
@@ -59,6 +60,13 @@ def run(args) -> int:
     check_outputs(output, assets_dir, Path(args.input))  # before the (slow) inference
     base = output.parent if output is not None else Path(".")
     named = Path(os.path.relpath(assets_dir.resolve(), base.resolve())).as_posix()
+    if unwritable(named):  # the grammar names the folder in a string (UTF-8 text)
+        print(
+            f"bgr infer: the assets folder {comment_text(named)} holds {unwritable(named)}, "
+            "which a grammar cannot name: choose another with --assets DIR",
+            file=sys.stderr,
+        )
+        return USAGE
     options = Options(
         up=args.up,
         level=args.level,

@@ -19,6 +19,7 @@ from tqdm import tqdm
 from bgr.grammar import nodes as n
 from bgr.grammar.errors import BgrError
 from bgr.grammar.parser import no_gc
+from bgr.grammar.safe_text import comment_text
 from bgr.interpreter.limits import check_memory, restart_memory
 
 from . import emit, tree
@@ -213,7 +214,8 @@ def place(
             f"object{len(carried) + 1}",
             f"{options.assets}/object{len(carried) + 1}.glb",
             _colour_of(obj.colors),
-            f"carried through as it is: {obj.kind} {obj.name} ({len(obj.faces)} triangles)",
+            f"carried through as it is: {comment_text(obj.kind, 60)} {comment_text(obj.name)} "
+            f"({len(obj.faces)} triangles)",
         )
         size = obj.vertices.max(axis=0) - low
         carried.append(
@@ -385,9 +387,9 @@ def build(
 def _header(scene: CityScene, comps: list[Component], types: Types, placed: Placed) -> list[str]:
     offset = ", ".join(f"{v:g}" for v in scene.offset)
     axes = ", with (x, y, z) = (east, up, -north)" if scene.up == "z" else ""
-    crs = f" in {scene.crs}" if scene.crs else ""
+    crs = f" in {comment_text(scene.crs)}" if scene.crs else ""  # input text: one safe line
     lines = [
-        f"# Inferred by bgr infer --kind city from {Path(scene.source).name}: "
+        f"# Inferred by bgr infer --kind city from {comment_text(Path(scene.source).name)}: "
         f"{len(scene.objects)} objects,",
         f"# {len(comps)} components in {len(placed.terminals)} types (level "
         f"{placed.level.index} of {len(types.levels) - 1}), {len(placed.rules)} non-terminal "

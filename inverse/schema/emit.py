@@ -24,7 +24,7 @@ import re
 from dataclasses import dataclass
 
 from bgr.grammar import nodes as n
-from bgr.grammar.registry import BUILTIN_NAMES, KEYWORDS, OPERATIONS
+from bgr.grammar.safe_text import RESERVED, comment_text, identifier
 from bgr.interpreter import split_solver as solver
 
 from . import faces as fs
@@ -32,12 +32,7 @@ from .model import Cell, Face, Model
 
 SIDES = ("front", "right", "back", "left")
 _IDENT = re.compile(r"[A-Za-z_][A-Za-z0-9_]*")
-_RESERVED = (
-    set(OPERATIONS)
-    | set(KEYWORDS)
-    | set(BUILTIN_NAMES)
-    | {"NIL", "true", "false", "and", "or", "not", "case", "else"}
-)
+_RESERVED = RESERVED
 
 
 @dataclass(frozen=True)
@@ -103,13 +98,8 @@ class Emitter:
 
     # ---- names ---------------------------------------------------------------------------
     def fresh(self, base: str) -> str:
-        base = re.sub(r"[^A-Za-z0-9_]", "_", base).strip("_") or "Part"
-        if not base[0].isalpha():
-            base = "R" + base
-        base = base[0].upper() + base[1:]
-        name, i = base, 2
-        while name in self.taken or name in _RESERVED:
-            name, i = f"{base}{i}", i + 1
+        """A new rule name from input text (a label, a face's name): safe_text.identifier."""
+        name = identifier(base, "Part", prefix="R", capital=True, taken=self.taken)
         self.taken.add(name)
         return name
 
@@ -266,7 +256,7 @@ class Emitter:
         faces = sum(len(b.faces) for b in self.model.blocks)
         leaves = sum(f.root.count() for f in self.model.faces())
         header = [
-            f"# Inferred by bgr infer --kind schema from {self.model.source or 'a model'}:",
+            f"# Inferred by bgr infer --kind schema from {self.source()}:",
             f"# {faces} faces, {leaves} subfaces; {len(self.rules)} schema rules. Derive it on a "
             "lot:",
             "#   bgr derive THIS.bgr --lot W,D|LOTS.geojson -o out.glb   (--set height=H)",
@@ -305,7 +295,7 @@ class Emitter:
         x_name, y_name = self.axis_names["x"], self.axis_names["y"]
         plural = "s" if len(faces) != 1 else ""
         header = [
-            f"# Inferred by bgr infer --kind schema from {self.model.source or 'a model'}:",
+            f"# Inferred by bgr infer --kind schema from {self.source()}:",
             f"# {len(faces)} flat façade{plural}, {leaves} subfaces; {len(self.rules) + 1} schema "
             "rules. The lot is the façade:",
             f"# its columns run along the lot's {x_name}, its rows (floors) along its {y_name}. "
@@ -325,6 +315,10 @@ class Emitter:
             name = self.by_key[face.root.key()] = self.fresh(face.name)
             self.rules.append(n.Rule(name, [], self.target(face.root)))
         return name
+
+    def source(self) -> str:
+        """The source's name as a comment can hold it (a file name is input: safe_text)."""
+        return comment_text(self.model.source) if self.model.source else "a model"
 
     def skipped_note(self) -> list[str]:
         if not self.model.skipped:

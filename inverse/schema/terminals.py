@@ -23,6 +23,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from bgr.grammar.errors import BgrError, Diagnostic, read_json
+from bgr.grammar.safe_text import unwritable
 from bgr.interpreter.limits import MAX_INPUT_COORDINATE
 
 from .model import Block, Cell, Face, Model, default_fixed
@@ -125,6 +126,8 @@ def read_terminals(data: dict, path: str = "<terminals>") -> list[_Terminal]:
         for key in ("label", "path"):
             if not isinstance(t.get(key), str) or not t.get(key):
                 raise _error(path, f"{where}.{key} must be a non-empty string")
+            if unwritable(t[key]):  # the inferred grammar writes it as a label string
+                raise _error(path, f"{where}.{key} holds {unwritable(t[key])}, which no label has")
         origin = _vector(t.get("origin"), 3, f"{where}.origin", path)
         axes_raw = t.get("axes")
         if not isinstance(axes_raw, list) or len(axes_raw) != 3:
