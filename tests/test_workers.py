@@ -57,7 +57,14 @@ def start(folder, *more):
         stderr=subprocess.PIPE,
         text=True,
         start_new_session=True,  # its own process group, so a signal to the group is only it
+        # as from a terminal: a shell's background jobs (CI's, say) start with SIGINT ignored,
+        # and Python then leaves Ctrl-C ignored, as a program run with '&' should
+        preexec_fn=_interruptible,
     )
+
+
+def _interruptible() -> None:
+    signal.signal(signal.SIGINT, signal.SIG_DFL)
 
 
 def busy_workers(child: subprocess.Popen, seconds: float = 30.0) -> list[psutil.Process]:
