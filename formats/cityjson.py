@@ -40,6 +40,7 @@ from bgr.grammar.errors import BgrError, Diagnostic
 from bgr.grammar.paths import read_input
 from bgr.interpreter.terminals import TerminalTable, lot_tables
 
+from .cityjson_checks import check_indices, checked_vertices
 from .meshes import bake, cross, unit_normals
 
 VERSION = "2.0"
@@ -559,10 +560,16 @@ def read_cityjson(path: str | Path, lod: str | None = None) -> CityModel:
             vertices = np.asarray(doc.get("vertices") or np.zeros((0, 3)), dtype=np.float64)
             if transform:
                 vertices = vertices * transform["scale"] + transform["translate"]
+            vertices = checked_vertices(vertices)  # before earcut and numpy see a NaN
             for ident, obj in doc["CityObjects"].items():
-                model.objects[ident] = _read_object(ident, obj, vertices.reshape(-1, 3), lod)
+                try:
+                    model.objects[ident] = _read_object(ident, obj, vertices, lod)
+                except ValueError as exc:
+                    raise ValueError(f"city object {ident[:80]!r}: {exc}") from None
         return model
-    except (ValueError, KeyError, TypeError, IndexError, AttributeError, RecursionError) as exc:
+    except (
+        ValueError, KeyError, TypeError, IndexError, AttributeError, RecursionError, OverflowError
+    ) as exc:  # fmt: skip
         raise BgrError(
             Diagnostic(shown, 0, 0, f"not a CityJSON file this reader can use: {exc}")
         ) from None
@@ -641,10 +648,12 @@ def _triangulate(vertices: np.ndarray, rings: list) -> np.ndarray:
     facing where the outer ring's Newell normal does."""
     outer = np.asarray(rings[0], dtype=np.int64)
     if len(rings) == 1 and len(outer) == 3:
+        check_indices(outer, len(vertices))
         return outer[None, :]
     import mapbox_earcut
 
     index = np.concatenate([np.asarray(r, dtype=np.int64) for r in rings])
+    check_indices(index, len(vertices))
     points = vertices[index]
     ring = vertices[outer]
     normal = np.sum(cross(ring, np.roll(ring, -1, axis=0)), axis=0)  # Newell
