@@ -6,8 +6,9 @@ warning or a temporary file left behind.
 The mutators (bench/fuzz_mutations.py) and the case runner (bench/fuzz_inverse.py, whose long
 run is recorded in docs/fuzzing.md) are the bench's; here hypothesis draws the mutations'
 seeds.  Each case is run the way the bench does: a fork()ed child with a 2 GB address space
-and a 10 s limit.  The number of cases per surface is ``pytest --fuzz-cases N`` or ``BGR_FUZZ_CASES`` (default 12, about 40 s for all
-seven surfaces on 2 shared cores).  The regression tests below are inputs the bench found.
+and a 10 s limit.  The number of cases per surface is ``pytest --fuzz-cases N`` or
+``BGR_FUZZ_CASES`` (default 12, about 50 s for all seven surfaces on 2 shared cores).  The
+regression tests below are inputs the bench found.
 """
 
 from __future__ import annotations
