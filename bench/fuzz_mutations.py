@@ -236,16 +236,36 @@ def mutate_gltf_uri(rng: random.Random, data: bytes) -> bytes:
     return _dumps(doc)
 
 
+def mutate_mild(rng: random.Random, data: bytes) -> bytes:
+    """Up to eight numbers of the text scaled or shifted a little: a file that still reads,
+    so that the cases reach the analysis after the reader (box overlaps, schemas, clusters)."""
+    matches = list(_NUMBER.finditer(data[:2_000_000]))
+    if not matches:
+        return mutate_bytes(rng, data)
+    out = data
+    for m in sorted(
+        rng.sample(matches, min(len(matches), rng.randint(1, 8))), key=lambda m: -m.start()
+    ):
+        value = float(m.group()) * rng.choice((0.5, 0.99, 1.01, 2, -1, 0)) + rng.choice((0, 1, -1))
+        text = str(int(value)) if b"." not in m.group() and value.is_integer() else repr(value)
+        out = out[: m.start()] + text.encode() + out[m.end() :]
+    return out
+
+
 MUTATORS = {
-    "obj": (mutate_lines, mutate_numbers, mutate_bytes),
-    "ply": (mutate_ply_header, mutate_numbers, mutate_bytes),
-    "gltf": (mutate_json, mutate_gltf_uri, mutate_numbers, mutate_bytes),
+    "obj": (mutate_mild, mutate_lines, mutate_numbers, mutate_bytes),
+    "ply": (mutate_mild, mutate_ply_header, mutate_numbers, mutate_bytes),
+    "gltf": (mutate_mild, mutate_json, mutate_gltf_uri, mutate_numbers, mutate_bytes),
     "glb": (mutate_glb, mutate_bytes),
-    "cityjson": (mutate_json, mutate_numbers, mutate_bytes),
-    "boxes": (mutate_json, mutate_numbers, mutate_bytes),
-    "captured": (mutate_json, mutate_numbers, mutate_bytes),
+    "cityjson": (mutate_mild, mutate_json, mutate_numbers, mutate_bytes),
+    "boxes": (mutate_mild, mutate_json, mutate_numbers, mutate_bytes),
+    "captured": (mutate_mild, mutate_json, mutate_numbers, mutate_bytes),
 }
-WEIGHTS = {"mutate_bytes": 1, "mutate_numbers": 2}  # the structural mutators get 3
+WEIGHTS = {
+    "mutate_bytes": 1,
+    "mutate_numbers": 2,
+    "mutate_mild": 2,
+}  # the structural mutators get 3
 
 
 def mutant(rng: random.Random, surface: str, data: bytes) -> bytes:
