@@ -322,7 +322,7 @@ Case = tuple[Seed, bytes, list[str], Outcome]
 def fuzz_case(seeds: list[Seed], index: int, base_seed: int, tmp: Path) -> Case:
     """Case ``index`` of a surface: the same mutant and command for the same seeds."""
     rng = random.Random(f"{base_seed}:{seeds[0].surface}:{index}")
-    folder = tmp / f"case{index}"
+    folder = tmp / f"{seeds[0].surface}{index}"
     folder.mkdir()
     return run_mutant(seeds, rng, folder)
 
@@ -345,8 +345,8 @@ def _worker(seeds, surfaces, cases, base_seed, part, parts, out: Path) -> None:
     """Run this worker's share of the cases; one JSON line per case in OUT/results-PART."""
     tmp = Path(tempfile.mkdtemp(prefix=f"bgr-fuzz-inverse-{part}-"))
     with open(out / f"results-{part}.jsonl", "w") as log:
-        for surface in surfaces:
-            for index in range(part, cases, parts):
+        for index in range(part, cases, parts):  # every surface in turn: a cut run covers all
+            for surface in surfaces:
                 seed, data, argv, outcome = fuzz_case(seeds[surface], index, base_seed, tmp)
                 row = {"surface": surface, "index": index, "kind": outcome.kind,
                        "seconds": round(outcome.seconds, 3), "seed": seed.name}  # fmt: skip
@@ -363,7 +363,7 @@ def _worker(seeds, surfaces, cases, base_seed, part, parts, out: Path) -> None:
                     row["stderr"] = outcome.stderr[-300:]
                 log.write(json.dumps(row) + "\n")
                 log.flush()
-                shutil.rmtree(tmp / f"case{index}", ignore_errors=True)
+                shutil.rmtree(tmp / f"{surface}{index}", ignore_errors=True)
     shutil.rmtree(tmp, ignore_errors=True)
 
 
