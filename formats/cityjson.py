@@ -40,7 +40,7 @@ from bgr.grammar.errors import BgrError, Diagnostic
 from bgr.grammar.paths import read_input
 from bgr.interpreter.terminals import TerminalTable, lot_tables
 
-from .cityjson_checks import check_indices, checked_vertices
+from .cityjson_checks import check_indices, fan, usable
 from .meshes import bake, cross, unit_normals
 
 VERSION = "2.0"
@@ -549,7 +549,7 @@ def read_cityjson(path: str | Path, lod: str | None = None) -> CityModel:
             lines = [json.loads(line) for line in text.splitlines() if line.strip()]
             head, features = (lines or [None])[0], lines[1:]
         else:
-            head, features = json.loads(text), []
+            head, features = _parse(shown, text), []
         if not isinstance(head, dict) or head.get("type") != "CityJSON":
             raise ValueError("the first object is not of type CityJSON")
         transform = head.get("transform")
@@ -559,8 +559,9 @@ def read_cityjson(path: str | Path, lod: str | None = None) -> CityModel:
                 raise ValueError('it has no "vertices"')
             vertices = np.asarray(doc.get("vertices") or np.zeros((0, 3)), dtype=np.float64)
             if transform:
-                vertices = vertices * transform["scale"] + transform["translate"]
-            vertices = checked_vertices(vertices)  # before earcut and numpy see a NaN
+                with np.errstate(over="ignore", invalid="ignore"):  # inf: named further on
+                    vertices = vertices * transform["scale"] + transform["translate"]
+            vertices = vertices.reshape(-1, 3)
             for ident, obj in doc["CityObjects"].items():
                 try:
                     model.objects[ident] = _read_object(ident, obj, vertices, lod)
@@ -572,6 +573,16 @@ def read_cityjson(path: str | Path, lod: str | None = None) -> CityModel:
     ) as exc:  # fmt: skip
         raise BgrError(
             Diagnostic(shown, 0, 0, f"not a CityJSON file this reader can use: {exc}")
+        ) from None
+
+
+def _parse(shown: str, text: str) -> Any:
+    """The JSON of a .city.json; a BgrError at the line and column where it stops parsing."""
+    try:
+        return json.loads(text)
+    except json.JSONDecodeError as exc:
+        raise BgrError(
+            Diagnostic(shown, exc.lineno, exc.colno, f"not a CityJSON file: not JSON: {exc.msg}")
         ) from None
 
 
@@ -655,6 +666,8 @@ def _triangulate(vertices: np.ndarray, rings: list) -> np.ndarray:
     index = np.concatenate([np.asarray(r, dtype=np.int64) for r in rings])
     check_indices(index, len(vertices))
     points = vertices[index]
+    if not usable(points):  # earcut (C++) and the normals must not see it; the caller names it
+        return fan(outer)
     ring = vertices[outer]
     normal = np.sum(cross(ring, np.roll(ring, -1, axis=0)), axis=0)  # Newell
     drop = int(np.argmax(np.abs(normal)))
