@@ -659,7 +659,8 @@ def _triangulate(vertices: np.ndarray, rings: list) -> np.ndarray:
     facing where the outer ring's Newell normal does."""
     outer = np.asarray(rings[0], dtype=np.int64)
     if len(rings) == 1 and len(outer) == 3:
-        check_indices(outer, len(vertices))
+        if not 0 <= min(rings[0]) <= max(rings[0]) < len(vertices):  # builtins: 3 numbers
+            check_indices(outer, len(vertices))
         return outer[None, :]
     import mapbox_earcut
 
