@@ -40,6 +40,7 @@ from bgr.grammar.errors import BgrError, Diagnostic
 from bgr.grammar.paths import read_input
 from bgr.interpreter.terminals import TerminalTable, lot_tables
 
+from .cityjson_checks import check_indices, fan, usable
 from .meshes import bake, cross, unit_normals
 
 VERSION = "2.0"
@@ -548,7 +549,7 @@ def read_cityjson(path: str | Path, lod: str | None = None) -> CityModel:
             lines = [json.loads(line) for line in text.splitlines() if line.strip()]
             head, features = (lines or [None])[0], lines[1:]
         else:
-            head, features = json.loads(text), []
+            head, features = _parse(shown, text), []
         if not isinstance(head, dict) or head.get("type") != "CityJSON":
             raise ValueError("the first object is not of type CityJSON")
         transform = head.get("transform")
@@ -558,13 +559,30 @@ def read_cityjson(path: str | Path, lod: str | None = None) -> CityModel:
                 raise ValueError('it has no "vertices"')
             vertices = np.asarray(doc.get("vertices") or np.zeros((0, 3)), dtype=np.float64)
             if transform:
-                vertices = vertices * transform["scale"] + transform["translate"]
+                with np.errstate(over="ignore", invalid="ignore"):  # inf: named further on
+                    vertices = vertices * transform["scale"] + transform["translate"]
+            vertices = vertices.reshape(-1, 3)
             for ident, obj in doc["CityObjects"].items():
-                model.objects[ident] = _read_object(ident, obj, vertices.reshape(-1, 3), lod)
+                try:
+                    model.objects[ident] = _read_object(ident, obj, vertices, lod)
+                except ValueError as exc:
+                    raise ValueError(f"city object {ident[:80]!r}: {exc}") from None
         return model
-    except (ValueError, KeyError, TypeError, IndexError, AttributeError, RecursionError) as exc:
+    except (
+        ValueError, KeyError, TypeError, IndexError, AttributeError, RecursionError, OverflowError
+    ) as exc:  # fmt: skip
         raise BgrError(
             Diagnostic(shown, 0, 0, f"not a CityJSON file this reader can use: {exc}")
+        ) from None
+
+
+def _parse(shown: str, text: str) -> Any:
+    """The JSON of a .city.json; a BgrError at the line and column where it stops parsing."""
+    try:
+        return json.loads(text)
+    except json.JSONDecodeError as exc:
+        raise BgrError(
+            Diagnostic(shown, exc.lineno, exc.colno, f"not a CityJSON file: not JSON: {exc.msg}")
         ) from None
 
 
@@ -641,11 +659,16 @@ def _triangulate(vertices: np.ndarray, rings: list) -> np.ndarray:
     facing where the outer ring's Newell normal does."""
     outer = np.asarray(rings[0], dtype=np.int64)
     if len(rings) == 1 and len(outer) == 3:
+        if not 0 <= min(rings[0]) <= max(rings[0]) < len(vertices):  # builtins: 3 numbers
+            check_indices(outer, len(vertices))
         return outer[None, :]
     import mapbox_earcut
 
     index = np.concatenate([np.asarray(r, dtype=np.int64) for r in rings])
+    check_indices(index, len(vertices))
     points = vertices[index]
+    if not usable(points):  # earcut (C++) and the normals must not see it; the caller names it
+        return fan(outer)
     ring = vertices[outer]
     normal = np.sum(cross(ring, np.roll(ring, -1, axis=0)), axis=0)  # Newell
     drop = int(np.argmax(np.abs(normal)))

@@ -31,8 +31,8 @@ def pytest_addoption(parser: pytest.Parser) -> None:
         "--fuzz-cases",
         type=int,
         default=None,
-        help="examples per fuzz test in tests/test_fuzz.py and tests/test_fuzz_geojson.py "
-        "(nightly: 100000); default: each test's own small count",
+        help="examples per fuzz test in tests/test_fuzz.py, tests/test_fuzz_geojson.py and "
+        "tests/test_fuzz_inverse.py (nightly: 100000); default: each test's own small count",
     )
 
 

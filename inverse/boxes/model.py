@@ -238,7 +238,8 @@ def _box(obj, name: str, where: str, ids: dict, fixed: tuple[bool, bool, bool]) 
             or not all(isinstance(c, int | float) and not isinstance(c, bool) for c in v)
         ):
             raise _fail(name, f'{here}: "{key}" must be three numbers [x, y, z]')
-        if not all(math.isfinite(c) and abs(c) < 1e9 for c in v):
+        # an int of 400 digits is no float: compare it as it is (math.isfinite would overflow)
+        if not all((not isinstance(c, float) or math.isfinite(c)) and abs(c) < 1e9 for c in v):
             raise _fail(
                 name, f'{here}: "{key}" holds a number that is not finite or is beyond 1e9 m'
             )

@@ -155,6 +155,9 @@ def _outline_vertices(flat: np.ndarray, size: np.ndarray) -> float:
     chosen = flat[facing > 1e-9] if np.any(facing > 1e-9) else flat[facing < -1e-9]
     if len(chosen) == 0:  # seen edge on: a line
         return 2.0
+    # the same triangle twice adds nothing to the union but its time (a face repeated 100,000
+    # times took 4 s; a million, 40): merge each distinct one once
+    chosen = np.unique(chosen.reshape(len(chosen), 6), axis=0).reshape(-1, 3, 2)
     polygons = shapely.polygons(np.concatenate([chosen, chosen[:, :1]], axis=1))
     try:
         outline = shapely.union_all(polygons)

@@ -186,8 +186,24 @@ def _clip(
     for normal, height in (((0.0, 1.0, 0.0), z0), ((0.0, -1.0, 0.0), z1)):
         if len(own) == 0:
             break
-        corners, own, tag = slice_faces_plane(
-            corners, own, np.array(normal), np.array([0.0, height, 0.0]), uv=tag
-        )
-    source = np.rint(tag[own[:, 0], 0]).astype(np.int64) if len(own) else np.zeros(0, np.int64)
-    return corners, np.asarray(own, dtype=np.int64).reshape(-1, 3), source
+        with np.errstate(all="ignore"):  # a sliver's barycentric weights: see _sources
+            corners, own, tag = slice_faces_plane(
+                corners, own, np.array(normal), np.array([0.0, height, 0.0]), uv=tag
+            )
+    own = np.asarray(own, dtype=np.int64).reshape(-1, 3)
+    source, keep = _sources(tag, own)
+    return corners, own[keep], source
+
+
+def _sources(tag: np.ndarray, own: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(the face each piece was cut from, which pieces have one).  trimesh interpolates a cut
+    corner's tag by barycentric weights, which a face of no area (a sliver of the first cut, a
+    collapsed input face) turns into NaN: such a corner is skipped for a sibling's tag, and a
+    piece with none is dropped (it has no area either) rather than cast to a wild index."""
+    if not len(own):
+        return np.zeros(0, np.int64), np.zeros(0, dtype=bool)
+    tags = tag[own, 0]  # (P, 3)
+    finite = np.isfinite(tags)
+    pick = tags[np.arange(len(own)), np.argmax(finite, axis=1)]
+    keep = finite.any(axis=1)
+    return np.rint(pick[keep]).astype(np.int64), keep

@@ -412,12 +412,14 @@ def _read_obj(shown: str, data: bytes) -> Found:
         hint = hint or ("the file is empty" if not data.strip() else "it has no `v` or `f` lines")
         raise BgrError(Diagnostic(shown, 0, 0, f"no triangles in {shown}", hint))
     corners = _obj_corners(obj, parsed, v_lines, f_lines)
-    faces, polygon = triangulate(vertices, parsed.sizes, corners)
-    colors = None if rgb is None else _face_colors(rgb, faces)
-    owner, objects = _obj_objects(obj, f_lines[polygon])
 
     def locate(vertex: int, axis: int, message: str, hint: str) -> BgrError:
         return obj.error(int(v_lines[vertex]), axis + 1, message, hint)
+
+    check_coordinates(shown, vertices, corners, None, [], locate)  # before any arithmetic
+    faces, polygon = triangulate(vertices, parsed.sizes, corners)
+    colors = None if rgb is None else _face_colors(rgb, faces)
+    owner, objects = _obj_objects(obj, f_lines[polygon])
 
     return Found(vertices, faces, colors, owner, objects, locate=locate)
 
@@ -698,15 +700,24 @@ def _earcut(vertices: np.ndarray, ring: np.ndarray) -> np.ndarray:
 
 def _read_ply(shown: str, data: bytes) -> Found:
     """A PLY read by trimesh: one mesh, whose objects are its connected components."""
+    import warnings
+
     import trimesh
 
+    from .ply_checks import check_header, check_mesh
+
+    check_header(shown, data)  # counts the file can hold, before trimesh allocates them
     try:
-        mesh = trimesh.load(io.BytesIO(data), file_type="ply", process=False)
+        with warnings.catch_warnings(), np.errstate(all="ignore"):
+            warnings.simplefilter("ignore")  # a NaN cast: check_coordinates names the vertex
+            mesh = trimesh.load(io.BytesIO(data), file_type="ply", process=False)
     except Exception as exc:  # trimesh raises whatever its parsers meet
         raise BgrError(
             Diagnostic(shown, 0, 0, f"not a PLY file bgr can read: {_reason(exc)}")
         ) from None
     faces = getattr(mesh, "faces", None)
+    if isinstance(mesh, trimesh.Trimesh) and faces is not None:
+        check_mesh(shown, np.asarray(mesh.vertices), np.asarray(faces))
     if not isinstance(mesh, trimesh.Trimesh) or faces is None or not len(faces):
         hint = "it holds points only" if isinstance(mesh, trimesh.PointCloud) else None
         raise BgrError(Diagnostic(shown, 0, 0, f"no triangles in {shown}", hint))

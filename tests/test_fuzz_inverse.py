@@ -1,0 +1,239 @@
+"""Mutation fuzzing of the inverse modules' readers (issue 25): whatever a city model, a box
+hierarchy or a captured model holds, ``bgr infer`` / ``bgr retarget`` succeed or fail with a
+message (exit 1), never a signal, a hang, a traceback, an internal error, a leaked Python
+warning or a temporary file left behind.
+
+The mutators (bench/fuzz_mutations.py) and the case runner (bench/fuzz_inverse.py, whose long
+run is recorded in docs/fuzzing.md) are the bench's; here hypothesis draws the mutations'
+seeds.  Each case is run the way the bench does: a fork()ed child with a 2 GB address space
+and a 10 s limit.  The number of cases per surface is ``pytest --fuzz-cases N`` or
+``BGR_FUZZ_CASES`` (default 10, about 45 s for all seven surfaces on 2 shared cores).  The
+regression tests below are inputs the bench found.
+"""
+
+from __future__ import annotations
+
+import json
+import random
+import sys
+import tempfile
+import warnings
+from pathlib import Path
+
+import numpy as np
+import pytest
+from hypothesis import HealthCheck, given, note, settings
+from hypothesis import strategies as st
+
+ROOT = Path(__file__).resolve().parent.parent
+sys.path.insert(0, str(ROOT / "bench"))
+
+import fuzz_inverse  # noqa: E402  (the mutators and the runner live with the long run)
+
+CASES = max(1, int(__import__("os").environ.get("BGR_FUZZ_CASES") or 10))
+
+pytestmark = pytest.mark.skipif(sys.platform == "win32", reason="the runner fork()s")
+
+
+@pytest.fixture(scope="module")
+def seeds() -> dict[str, list[fuzz_inverse.Seed]]:
+    with tempfile.TemporaryDirectory() as tmp:
+        return fuzz_inverse.build_seeds(Path(tmp))
+
+
+def _run(folder: Path, argv: list[str]) -> fuzz_inverse.Outcome:
+    return fuzz_inverse.run_case(argv, folder)
+
+
+# ---------------------------------------------------------------- the property, per surface
+
+
+@pytest.mark.parametrize("surface", fuzz_inverse.SURFACES)
+def test_seeds_are_read(seeds, surface, tmp_path):
+    """Every seed, unmutated, infers: the mutations start from files the readers take."""
+    assert seeds[surface], f"no seed for {surface}"
+    for k, seed in enumerate(seeds[surface]):
+        folder = tmp_path / str(k)
+        folder.mkdir()
+        (folder / seed.name).write_bytes(seed.data)
+        for name, extra in seed.extra.items():
+            (folder / name).write_bytes(extra)
+        outcome = _run(folder, fuzz_inverse.command(surface, seed.name, random.Random(0)))
+        assert outcome.kind == "success", (seed.name, outcome.stderr)
+
+
+@pytest.mark.parametrize("surface", fuzz_inverse.SURFACES)
+def test_mutants_succeed_or_fail_cleanly(seeds, surface):
+    """A mutant ends in exit 0, or exit 1 with a message, within 10 s and 2 GB."""
+
+    @settings(max_examples=CASES, database=None, suppress_health_check=list(HealthCheck))
+    @given(st.integers(0, 2**63))
+    def case(draw: int) -> None:
+        with tempfile.TemporaryDirectory() as tmp:
+            seed, data, argv, outcome = fuzz_inverse.run_mutant(
+                seeds[surface], random.Random(draw), Path(tmp)
+            )
+        note(f"bgr {' '.join(argv)} on a mutant of {seed.name} ({len(data)} bytes)")
+        assert not outcome.failed, (
+            f"{outcome.kind} after {outcome.seconds:.1f} s:\n{outcome.stderr}"
+        )
+
+    case()
+
+
+# ---------------------------------------------------------------- what the bench found
+
+
+def _write(folder: Path, name: str, data: bytes | str) -> None:
+    (folder / name).write_bytes(data.encode() if isinstance(data, str) else data)
+
+
+def test_obj_coordinates_are_checked_before_any_arithmetic(tmp_path):
+    """A vertex of -1e308 was triangulated (numpy overflow warnings on the user's terminal)
+    before the coordinate check named it; now the check comes first, at its line."""
+    obj = fuzz_inverse.BOX_OBJ.replace(b"v 0 3 0\n", b"v 0 -1e308 0\n", 1)
+    _write(tmp_path, "city.obj", obj)
+    outcome = _run(tmp_path, ["infer", "city.obj", "-o", "out.bgr"])
+    assert outcome.kind == "error", outcome.stderr
+    assert "city.obj:5:" in outcome.stderr and "Warning" not in outcome.stderr
+
+
+PLY_HEAD = "ply\nformat ascii 1.0\nelement vertex {v}\nproperty float x\nproperty float y\n"
+PLY_HEAD += "property float z\nelement face {f}\nproperty list uchar int vertex_indices\n"
+PLY_HEAD += "end_header\n"
+PLY_BODY = "0 0 0\n4 0 0\n4 3 0\n0 3 5\n3 0 1 2\n3 0 2 {k}\n"
+
+
+@pytest.mark.parametrize("count", ["1000000000", "4294967295"])
+def test_ply_header_counts_are_checked_against_the_file_size(tmp_path, count):
+    """A header that claims a billion vertices in a 100-byte file is refused at its line,
+    before trimesh sizes arrays by it."""
+    _write(tmp_path, "city.ply", PLY_HEAD.format(v=count, f=2) + PLY_BODY.format(k=3))
+    outcome = _run(tmp_path, ["infer", "city.ply", "-o", "out.bgr"])
+    assert outcome.kind == "error", outcome.stderr
+    assert "city.ply:3:1:" in outcome.stderr and "more than the file's" in outcome.stderr
+
+
+def test_ply_negative_count_is_a_located_error(tmp_path):
+    _write(tmp_path, "city.ply", PLY_HEAD.format(v="-1", f=2) + PLY_BODY.format(k=3))
+    outcome = _run(tmp_path, ["infer", "city.ply", "-o", "out.bgr"])
+    assert outcome.kind == "error" and "city.ply:3:1:" in outcome.stderr, outcome.stderr
+
+
+@pytest.mark.parametrize("index", ["2147483647", "-5", "nan"])
+def test_ply_face_indices_name_vertices_of_the_file(tmp_path, index):
+    """A face index beyond the vertices reached numpy as it was ("index 2147483647 is out of
+    bounds for axis 0 with size 4", or a cast warning for NaN); now the face is named."""
+    _write(tmp_path, "city.ply", PLY_HEAD.format(v=4, f=2) + PLY_BODY.format(k=index))
+    outcome = _run(tmp_path, ["infer", "city.ply", "-o", "out.bgr"])
+    assert outcome.kind == "error", outcome.stderr
+    assert "face 2 (counted from 1) names vertex" in outcome.stderr
+
+
+def _cityjson(vertices: list, boundaries: list) -> str:
+    return json.dumps(
+        {
+            "type": "CityJSON",
+            "version": "2.0",
+            "transform": {"scale": [1, 1, 1], "translate": [0, 0, 0]},
+            "CityObjects": {
+                "b1": {
+                    "type": "Building",
+                    "geometry": [{"type": "MultiSurface", "lod": "1", "boundaries": boundaries}],
+                }
+            },
+            "vertices": vertices,
+        },
+        allow_nan=True,
+    )
+
+
+SQUARE = [[0, 0, 0], [4, 0, 0], [4, 3, 0], [0, 3, 0], [0, 0, 5], [4, 0, 5]]
+
+
+@pytest.mark.parametrize("bad", [float("inf"), float("nan"), 1e300])
+def test_cityjson_vertices_are_checked_before_earcut(tmp_path, bad):
+    """A vertex of inf or NaN reached earcut (C++) and the Newell normals (numpy warnings);
+    now the surface is not computed with, and the coordinate check names the city object."""
+    vertices = [*SQUARE[:-1], [4, bad, 5]]
+    _write(tmp_path, "c.city.json", _cityjson(vertices, [[[0, 1, 2, 3]], [[0, 1, 5, 4]]]))
+    outcome = _run(tmp_path, ["infer", "c.city.json", "-o", "out.bgr"])
+    assert outcome.kind == "error", outcome.stderr
+    assert "a vertex of Building 'b1': y = " in outcome.stderr
+    assert "Warning" not in outcome.stderr
+
+
+@pytest.mark.parametrize("index", [-1, 6, 10**12])
+def test_cityjson_boundary_indices_name_vertices_of_the_file(tmp_path, index):
+    """A boundary index of -1 wrapped round to the last vertex (a wrong model, exit 0); one
+    of 10**12 failed in numpy without naming the object."""
+    rings = [[[0, 1, 2, 3]], [[0, 1, 5, index]]]
+    _write(tmp_path, "c.city.json", _cityjson(SQUARE, rings))
+    outcome = _run(tmp_path, ["infer", "c.city.json", "-o", "out.bgr"])
+    assert outcome.kind == "error", outcome.stderr
+    assert "city object 'b1'" in outcome.stderr and f"names vertex {index}" in outcome.stderr
+
+
+def test_slabs_skip_slivers_instead_of_casting_nan(tmp_path):
+    """Cutting a face of no area divided by zero in trimesh's barycentric weights, and the NaN
+    face index was cast to -2**63 (a RuntimeWarning on the terminal, a wrong face)."""
+    from bgr.inverse.city.cuts import _clip
+
+    vertices = np.array([[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 0, 0], [0, 2, 0], [0, 4, 0]], float)
+    faces = np.array([[0, 1, 2], [3, 4, 5]])  # the second: three points on a line, crossing y=1
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        corners, own, source = _clip(vertices, faces, np.array([0, 1]), 0.25, 3.0)
+    assert set(source.tolist()) <= {0, 1} and len(own) == len(source)
+
+
+def test_boxes_integer_of_400_digits_is_a_clean_error(tmp_path):
+    """``"min": [10**400, 0, 0]`` overflowed math.isfinite (internal error)."""
+    doc = json.loads((ROOT / "examples/boxes/building.json").read_text())
+    doc["root"]["min"][0] = 10**400
+    _write(tmp_path, "b.json", json.dumps(doc))
+    outcome = _run(tmp_path, ["retarget", "b.json", "--size", "12,9,30", "-o", "out.bgr"])
+    assert outcome.kind == "error" and "beyond 1e9 m" in outcome.stderr, outcome.stderr
+
+
+def test_a_face_repeated_100000_times_is_merged_once(monkeypatch):
+    """An OBJ whose one `f` line is repeated 100,000 times spent 4 s in shapely's union of
+    the same triangle (a million copies: 40 s, a hang); each distinct triangle is merged once."""
+    import shapely
+
+    from bgr.inverse.city import components
+
+    merged: list[int] = []
+    original = shapely.union_all
+
+    def union_all(polygons, **kwargs):
+        merged.append(len(polygons))
+        return original(polygons, **kwargs)
+
+    monkeypatch.setattr(components.shapely, "union_all", union_all)
+    one = np.array([[[0.0, 0.0], [4.0, 0.0], [4.0, 3.0]], [[0.0, 0.0], [4.0, 3.0], [0.0, 3.0]]])
+    size = np.array([4.0, 3.0, 1.0])
+    assert components._outline_vertices(np.repeat(one, 100_000, axis=0), size) == 4
+    assert merged == [2]
+
+
+def test_captured_model_of_100000_values_is_refused_before_the_schema(tmp_path):
+    """corner_shop.json's block repeated 101 times (1.2 MB, 108,000 JSON values) spent 9 s in
+    the schema validator, and 36 s with an error in each copy to explain (a hang): it is
+    refused, in about a second, before validation."""
+    doc = json.loads((ROOT / "examples/captured/corner_shop.json").read_text())
+    doc["blocks"] = doc["blocks"] * 101
+    _write(tmp_path, "m.json", json.dumps(doc))
+    outcome = _run(tmp_path, ["infer", "m.json", "--kind", "schema", "-o", "out.bgr"])
+    assert outcome.kind == "error", outcome.stderr
+    assert "more than 20,000 JSON values" in outcome.stderr and outcome.seconds < 5
+
+
+def test_cityjson_that_does_not_parse_is_located(tmp_path):
+    """Truncated CityJSON said "Expecting value: line 3 column 1" inside an unlocated message;
+    the error is now at that line and column, as editors and other readers report it."""
+    _write(tmp_path, "c.city.json", '{"type": "CityJSON",\n "vertices": [\n')
+    outcome = _run(tmp_path, ["infer", "c.city.json", "-o", "out.bgr"])
+    assert outcome.kind == "error" and "c.city.json:3:1: error: not a CityJSON file: not JSON" in (
+        outcome.stderr
+    ), outcome.stderr
