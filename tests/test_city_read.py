@@ -143,6 +143,16 @@ def test_obj_faces_that_repeat_a_vertex_are_dropped(tmp_path):
     assert scene.triangles == 1
 
 
+def test_a_face_repeated_in_its_object_is_read_once_and_its_reverse_stays(tmp_path):
+    # a repeated face adds no surface but all the work of one: 3,000 copies took 10 s to infer
+    text = "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 0 1\no a\n" + "f 1 2 3\nf 2 3 1\n" * 3000
+    text += "f 3 2 1\nf 1 2 4\no b\nf 1 2 3\n"
+    scene = read_city(write_text(tmp_path / "repeated.obj", text), up="y")
+    by_name = {obj.name: obj for obj in scene.objects}
+    assert len(by_name["a"].faces) == 3  # 1 2 3 (and its rotation 2 3 1), 3 2 1, 1 2 4
+    assert len(by_name["b"].faces) == 1  # the same triangle in another object stays there
+
+
 def test_obj_vertex_colours_are_averaged_per_face(tmp_path):
     text = "v 0 0 0 1 0 0\nv 1 0 0 1 0 0\nv 1 1 0 0 0 1\nf 1 2 3\n"
     (obj,) = read_city(write_text(tmp_path / "rgb.obj", text), up="y").objects

@@ -237,3 +237,17 @@ def test_cityjson_that_does_not_parse_is_located(tmp_path):
     assert outcome.kind == "error" and "c.city.json:3:1: error: not a CityJSON file: not JSON" in (
         outcome.stderr
     ), outcome.stderr
+
+
+def test_a_cityjson_surface_listed_3000_times_is_read_once(tmp_path):
+    """A MultiSurface whose surfaces were repeated 3,000 times (321,000 triangles of the same
+    few) spent 10 s cutting and fitting the copies (a timeout in the long run): a triangle that
+    repeats an earlier one of its object is dropped as it is read."""
+    from bgr.inverse.city.read import read_city
+
+    rings = [[[0, 1, 2, 3]], [[0, 1, 5, 4]]] * 3000
+    _write(tmp_path, "c.city.json", _cityjson(SQUARE, rings))
+    scene = read_city(tmp_path / "c.city.json")
+    assert scene.triangles == 4  # the floor's two triangles and the wall's two
+    outcome = _run(tmp_path, ["infer", "c.city.json", "-o", "out.bgr"])
+    assert outcome.kind == "success", outcome.stderr
