@@ -242,6 +242,8 @@ def _child(argv: list[str], folder: Path, limit_bytes: int) -> None:
         signal.signal(signal.SIGINT, signal.SIG_DFL)
         _print_warnings()
         code = main(argv)
+        if code == 0:
+            code = _check_output(Path("out.bgr"))
     except SystemExit as e:
         code = e.code if isinstance(e.code, int) else 2
     except BaseException:  # noqa: BLE001  (what main() let through is the failure itself)
@@ -255,6 +257,34 @@ def _child(argv: list[str], folder: Path, limit_bytes: int) -> None:
             sys.stderr.flush()
         finally:
             os._exit(code)
+
+
+def _check_output(path: Path) -> int:
+    """0 when the grammar a case wrote parses and holds nothing its input injected (an attr
+    ``evil`` or an import of ``x.bgr``: the hostile names' payloads, bench/fuzz_structure.py),
+    else a failure's status with what is wrong on standard error."""
+    from bgr.grammar import nodes as n
+    from bgr.grammar.errors import BgrError
+    from bgr.grammar.parser import parse
+
+    if not path.exists():
+        return 0
+    text = path.read_text(encoding="utf-8")
+    try:
+        module = parse(text, str(path))
+    except BgrError as exc:
+        print(f"unparsable output: {exc}", file=sys.stderr)
+        return 72
+    for item in module.items:
+        if (isinstance(item, n.Attr) and item.name == "evil") or (
+            isinstance(item, n.Import) and "x.bgr" in str(item.path)
+        ):
+            print(f"injected output: {item}", file=sys.stderr)
+            return 73
+    if any(not line.isprintable() for line in text.split("\n")):
+        print("injected output: a line holds a control character", file=sys.stderr)
+        return 73
+    return 0
 
 
 def _print_warnings() -> None:

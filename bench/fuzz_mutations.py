@@ -16,6 +16,8 @@ import random
 import re
 import struct
 
+import fuzz_structure
+
 HOSTILE_NUMBERS = (
     "nan", "NaN", "inf", "-inf", "Infinity", "-Infinity", "1e308", "-1e308", "1e400", "-1e400",
     "1e-320", "0", "-0", "-1", "-2", "2147483647", "2147483648", "4294967296",
@@ -252,19 +254,31 @@ def mutate_mild(rng: random.Random, data: bytes) -> bytes:
     return out
 
 
+def mutate_box_tree(rng: random.Random, data: bytes) -> bytes:
+    """A box hierarchy changed so that it stays valid (bench/fuzz_structure.py)."""
+    return fuzz_structure.mutate_boxes(rng, data, mutate_json)
+
+
+def mutate_parts(rng: random.Random, data: bytes) -> bytes:
+    """A captured model changed so that it stays valid (bench/fuzz_structure.py)."""
+    return fuzz_structure.mutate_captured(rng, data, mutate_json)
+
+
 MUTATORS = {
     "obj": (mutate_mild, mutate_lines, mutate_numbers, mutate_bytes),
     "ply": (mutate_mild, mutate_ply_header, mutate_numbers, mutate_bytes),
     "gltf": (mutate_mild, mutate_json, mutate_gltf_uri, mutate_numbers, mutate_bytes),
     "glb": (mutate_glb, mutate_bytes),
     "cityjson": (mutate_mild, mutate_json, mutate_numbers, mutate_bytes),
-    "boxes": (mutate_mild, mutate_json, mutate_numbers, mutate_bytes),
-    "captured": (mutate_mild, mutate_json, mutate_numbers, mutate_bytes),
+    "boxes": (mutate_box_tree, mutate_mild, mutate_json, mutate_numbers, mutate_bytes),
+    "captured": (mutate_parts, mutate_mild, mutate_json, mutate_numbers, mutate_bytes),
 }
 WEIGHTS = {
     "mutate_bytes": 1,
     "mutate_numbers": 2,
     "mutate_mild": 2,
+    "mutate_box_tree": 6,
+    "mutate_parts": 6,
 }  # the structural mutators get 3
 
 

@@ -81,6 +81,44 @@ def test_mutants_succeed_or_fail_cleanly(seeds, surface):
     case()
 
 
+@pytest.mark.parametrize("surface", ["boxes", "captured"])
+def test_structural_mutants_reach_past_the_reader(seeds, surface):
+    """The valid-preserving mutators (bench/fuzz_structure.py) exist so that cases reach the
+    analysis: byte and number mutants of these files passed the reader 1 to 3.5 % of the time.
+    Of 16 structural mutants (hostile ids and labels, deep splits, halved parts), some succeed,
+    and whatever each wrote parses without an injected line."""
+    import fuzz_mutations
+
+    mutate = {"boxes": fuzz_mutations.mutate_box_tree, "captured": fuzz_mutations.mutate_parts}
+    succeeded = 0
+    for k in range(16):
+        rng = random.Random(k)
+        seed = seeds[surface][k % len(seeds[surface])]
+        with tempfile.TemporaryDirectory() as tmp:
+            folder = Path(tmp)
+            (folder / seed.name).write_bytes(mutate[surface](rng, seed.data))
+            for name, extra in seed.extra.items():
+                (folder / name).write_bytes(extra)
+            outcome = _run(folder, fuzz_inverse.command(surface, seed.name, rng))
+        assert not outcome.failed, (k, outcome.kind, outcome.stderr)
+        succeeded += outcome.kind == "success"
+    assert succeeded >= 4, succeeded
+
+
+@pytest.mark.parametrize(
+    "written",
+    ["attr evil = 1\nLot --> NIL\n", 'import "x.bgr" as x\nLot --> NIL\n', "# a\x07b\n",
+     "Lot --> (\n"],
+)  # fmt: skip
+def test_an_output_with_an_injected_line_is_a_failure(tmp_path, written):
+    """The bench's oracle: a case that exits 0 must have written a grammar that parses and
+    holds nothing its input's names injected."""
+    (tmp_path / "out.bgr").write_text(written)
+    assert fuzz_inverse._check_output(tmp_path / "out.bgr") != 0
+    (tmp_path / "out.bgr").write_text("# attr evil = 1\nLot --> NIL\n")
+    assert fuzz_inverse._check_output(tmp_path / "out.bgr") == 0
+
+
 # ---------------------------------------------------------------- what the bench found
 
 
