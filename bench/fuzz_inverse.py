@@ -374,6 +374,13 @@ def run_mutant(seeds: list[Seed], rng: random.Random, folder: Path) -> Case:
 def _worker(seeds, surfaces, cases, base_seed, part, parts, out: Path) -> None:
     """Run this worker's share of the cases; one JSON line per case in OUT/results-PART."""
     tmp = Path(tempfile.mkdtemp(prefix=f"bgr-fuzz-inverse-{part}-"))
+    try:
+        _cases(seeds, surfaces, cases, base_seed, part, parts, out, tmp)
+    finally:
+        shutil.rmtree(tmp, ignore_errors=True)
+
+
+def _cases(seeds, surfaces, cases, base_seed, part, parts, out: Path, tmp: Path) -> None:
     with open(out / f"results-{part}.jsonl", "w") as log:
         for index in range(part, cases, parts):  # every surface in turn: a cut run covers all
             for surface in surfaces:
@@ -394,7 +401,6 @@ def _worker(seeds, surfaces, cases, base_seed, part, parts, out: Path) -> None:
                 log.write(json.dumps(row) + "\n")
                 log.flush()
                 shutil.rmtree(tmp / f"{surface}{index}", ignore_errors=True)
-    shutil.rmtree(tmp, ignore_errors=True)
 
 
 def table(rows: list[dict]) -> str:
@@ -462,8 +468,11 @@ def main(argv: list[str] | None = None) -> int:
     seconds = time.perf_counter() - start
     print(report)
     print(f"{len(rows):,} cases in {seconds:.0f} s (seed {args.seed}); results in {out}")
+    if len(rows) < args.cases * len(surfaces):
+        print(f"a worker stopped early: {args.cases * len(surfaces) - len(rows):,} cases not run")
     (out / "table.md").write_text(report + "\n")
-    return 1 if any(r["kind"] not in ("success", "error") for r in rows) else 0
+    failed = any(r["kind"] not in ("success", "error") for r in rows)
+    return 1 if failed or len(rows) < args.cases * len(surfaces) else 0
 
 
 if __name__ == "__main__":

@@ -31,6 +31,10 @@ HOSTILE_JSON = (
 )  # fmt: skip
 
 
+# what a mutator raises on a document an earlier mutation reshaped ("buffers": [3], 10**400)
+SHAPE_ERRORS = (TypeError, LookupError, AttributeError, ValueError, ArithmeticError, RecursionError)
+
+
 def _json_paths(node, path=()):
     """Every (path, value) of a JSON document, depth first."""
     yield path, node
@@ -287,7 +291,11 @@ def mutant(rng: random.Random, surface: str, data: bytes) -> bytes:
     mutators = MUTATORS[surface]
     weights = [WEIGHTS.get(m.__name__, 3) for m in mutators]
     for _ in range(rng.choice((1, 1, 1, 2, 3))):
-        data = rng.choices(mutators, weights)[0](rng, data)
+        mutator = rng.choices(mutators, weights)[0]
+        try:
+            data = mutator(rng, data)
+        except SHAPE_ERRORS:  # an earlier mutation left a shape this one does not expect
+            data = mutate_bytes(rng, data)
         if len(data) > 50_000_000:
             data = data[:50_000_000]
     return data

@@ -63,7 +63,7 @@ def _changed(rng: random.Random, data: bytes, fallback: Callable, change: Callab
         doc = json.loads(data)
         change(rng, doc)
         return json.dumps(doc).encode()
-    except (ValueError, RecursionError, KeyError, IndexError, TypeError, AttributeError):
+    except (ValueError, ArithmeticError, RecursionError, LookupError, TypeError, AttributeError):
         return fallback(rng, data)
 
 
