@@ -21,7 +21,7 @@ from typing import Any
 
 from . import __version__
 from .formats.atomic import Terminated, on_sigterm, reset_termination
-from .grammar.errors import BgrError, Diagnostic
+from .grammar.errors import BgrError, Diagnostic, terminal_text
 from .grammar.formatter import format_module
 from .grammar.loader import decode, load, read_source
 from .grammar.parser import parse
@@ -815,7 +815,8 @@ def _infer(args) -> int:
         sys.stdout.write(text)
     else:
         write_atomic(Path(args.output), text)
-        print(f"{args.output}: {text.count(chr(10))} lines", file=sys.stderr)
+        shown = terminal_text(args.output, keep="")
+        print(f"{shown}: {text.count(chr(10))} lines", file=sys.stderr)
     return EXIT_OK
 
 

@@ -24,11 +24,19 @@ class Diagnostic:
     severity: str = "error"  # or "warning": the run goes on (bgr derive prints it, Result keeps it)
 
     def render(self) -> str:
-        where = f"{self.path}:{self.line}:{self.column}" if self.line else self.path
-        head = f"{self.severity}: {self.message}"
+        """The message as a terminal shows it: every character of the input it quotes (a file
+        name, a box id, a source line) that would move the cursor, colour the terminal or
+        turn the text (ESC, CR, NUL, bidi controls) written as its escape (``\\x1b``)."""
+        path = terminal_text(self.path, keep="")
+        where = f"{path}:{self.line}:{self.column}" if self.line else path
+        head = f"{self.severity}: {terminal_text(self.message)}"
         out = [f"{where}: {head}" if where else head]
         if self.source_line is not None and self.line:
             text, column = _excerpt(self.source_line.rstrip("\r\n"), self.column)
+            if not text.replace("\t", " ").isprintable():  # the caret stays under its character
+                cut = max(column - 1, 0)
+                before = terminal_text(text[:cut], keep="\t")
+                text, column = before + terminal_text(text[cut:], keep="\t"), len(before) + 1
             gutter = f"{self.line:>5} | "
             out.append(gutter + text)
             # keep tabs so that the caret lines up under tab-indented code
@@ -36,8 +44,16 @@ class Diagnostic:
             width = max(1, min(self.length, max(len(text) - column + 1, 1)))
             out.append(" " * (len(gutter) - 2) + "| " + lead + "^" + "~" * (width - 1))
         if self.hint:
-            out.append(f"hint: {self.hint}")
+            out.append(f"hint: {terminal_text(self.hint)}")
         return "\n".join(out)
+
+
+def terminal_text(text: str, keep: str = "\n\t") -> str:
+    """``text`` with each character that is not printable, but those in ``keep``, written as
+    its Python escape: what an error quotes from a hostile file cannot drive the terminal."""
+    if text.isprintable():
+        return text
+    return "".join(c if c.isprintable() or c in keep else repr(c)[1:-1] for c in text)
 
 
 _SHOWN = 160  # characters of a source line a message shows: a 10 MB line is cut around the caret

@@ -483,3 +483,25 @@ def test_terminal_lists_cannot_inject_grammar(tmp_path, capsys):
             assert shape(text) - Counter({"Rule": 99}) == shape(benign) - Counter({"Rule": 99})
     for stem in (EVIL_FILE, FILE_PAYLOAD, "\udcff"):
         assert terminals_case(tmp_path, stem, base, capsys, benign) is not None
+
+
+# ---- the terminal -----------------------------------------------------------------------------
+
+ESCAPES = "\x1b[2J\x1b]0;owned\x07\r\x00\u202e"  # clear, retitle, return, NUL, right-to-left
+
+
+def test_messages_cannot_drive_the_terminal(tmp_path, capsys):
+    """What bgr prints quotes its input (file names, box ids): a control character there is
+    written as its escape, so that a file cannot clear, retitle or rewrite the user's terminal."""
+    doc = boxes_doc(ESCAPES, None)
+    doc["root"]["children"][1]["id"] = ESCAPES  # two boxes with that id: an error naming it
+    (tmp_path / "dup.json").write_text(json.dumps(doc))
+    code, err = run(["retarget", tmp_path / "dup.json", "--size", "10,10,10"], capsys)
+    assert code == 1 and "two boxes have the id" in err, err
+    assert "\\x1b[2J" in err
+    source = tmp_path / f"city{ESCAPES[:-2]}.obj"  # a file name (no NUL)
+    source.write_text(obj_text("box"))
+    code, err = run(["infer", source, "-o", tmp_path / f"out{ESCAPES[:-2]}.bgr"], capsys)
+    assert code == 0 and "\\x1b]0;owned\\x07\\r" in err, err
+    for printed in (err, run(["infer", source, "--kind", "boxes"], capsys)[1]):
+        assert not any(c in printed for c in "\x1b\x07\r\x00\u202e"), repr(printed)

@@ -13,7 +13,7 @@ import numpy as np
 
 from bgr.formats.atomic import cannot_write
 from bgr.formats.atomic import write_text as write_atomic
-from bgr.grammar.errors import BgrError, Diagnostic
+from bgr.grammar.errors import BgrError, Diagnostic, terminal_text
 from bgr.grammar.formatter import format_module
 from bgr.grammar.paths import check_input, check_output, roots_of, within
 from bgr.interpreter.limits import restart_memory
@@ -44,7 +44,7 @@ def run_retarget(args) -> int:
         size = parse_size(args.size)
         check_order(args.order)
     except (ValueError, BgrError) as e:
-        print(f"bgr retarget: {getattr(e, 'message', e)}", file=sys.stderr)
+        print(f"bgr retarget: {terminal_text(str(getattr(e, 'message', e)))}", file=sys.stderr)
         return USAGE
     out = None if args.output in (None, "-") else Path(args.output)
     source = Path(args.input)
@@ -66,7 +66,8 @@ def run_retarget(args) -> int:
         raise located(e, source) from None
     boxes = sum(1 for _ in result.walk())
     print(
-        f"{args.output or '<stdout>'}: {boxes} boxes ({sum(1 for _ in root.walk())} in the input), "
+        f"{terminal_text(args.output or '<stdout>', keep='')}: {boxes} boxes "
+        f"({sum(1 for _ in root.walk())} in the input), "
         f"{_size(result)}; {kept} of {total} alignments kept",
         file=sys.stderr,
     )
@@ -262,7 +263,8 @@ def run_infer(args) -> int:
         write_atomic(out, text)
     how = "exact" if written.exact else "approximate"
     print(
-        f"{args.output or '<stdout>'}: {len(written.module.rules())} rules, {how}; {report}",
+        f"{terminal_text(args.output or '<stdout>', keep='')}: {len(written.module.rules())} "
+        f"rules, {how}; {terminal_text(report)}",
         file=sys.stderr,
     )
     return 0

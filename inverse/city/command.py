@@ -6,7 +6,7 @@ import os
 import sys
 from pathlib import Path
 
-from bgr.grammar.errors import BgrError
+from bgr.grammar.errors import BgrError, terminal_text
 from bgr.grammar.safe_text import comment_text, unwritable
 
 from .components import FEATURES
@@ -83,11 +83,12 @@ def run(args) -> int:
     text = to_text(grammar)
     write(grammar, text, output, assets_dir, keep=(Path(args.input),))
     placed = grammar.placed
+    wrote = "" if output is None else f"; wrote {terminal_text(str(output), keep='')}"
     print(
-        f"{args.input}: {len(grammar.scene.objects)} objects, {len(grammar.comps)} components, "
-        f"{len(placed.terminals)} types at level {placed.level.index}, {len(placed.rules)} rules"
-        f"{'' if output is None else f'; wrote {output}'} and {len(grammar.assets)} meshes in "
-        f"{assets_dir}",
+        f"{terminal_text(args.input, keep='')}: {len(grammar.scene.objects)} objects, "
+        f"{len(grammar.comps)} components, {len(placed.terminals)} types at level "
+        f"{placed.level.index}, {len(placed.rules)} rules{wrote} and {len(grammar.assets)} meshes "
+        f"in {terminal_text(str(assets_dir), keep='')}",
         file=sys.stderr,
     )
     if args.stats:
