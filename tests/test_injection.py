@@ -505,3 +505,18 @@ def test_messages_cannot_drive_the_terminal(tmp_path, capsys):
     assert code == 0 and "\\x1b]0;owned\\x07\\r" in err, err
     for printed in (err, run(["infer", source, "--kind", "boxes"], capsys)[1]):
         assert not any(c in printed for c in "\x1b\x07\r\x00\u202e"), repr(printed)
+
+
+def test_messages_cut_what_they_quote(tmp_path, capsys):
+    """A 100,000-character id or label is legal input, but an error quoting it whole buried
+    the message (the long fuzz run kept only its last 4,000 characters): it is cut."""
+    doc = boxes_doc(LONG, None)
+    doc["root"]["children"][1]["id"] = LONG
+    (tmp_path / "dup.json").write_text(json.dumps(doc))
+    code, err = run(["retarget", tmp_path / "dup.json", "--size", "10,10,10"], capsys)
+    assert code == 1 and "two boxes have the id 'xxx" in err and len(err) < 1000, err[:300]
+    model = json.loads((EXAMPLES / "captured" / "corner_shop.json").read_text())
+    model["labels"][LONG + "!"] = {"fixed": True}
+    (tmp_path / "m.json").write_text(json.dumps(model))
+    code, err = run(["infer", tmp_path / "m.json", "--kind", "schema"], capsys)
+    assert code == 1 and "not a valid label" in err and len(err) < 1000, err[:300]

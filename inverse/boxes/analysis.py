@@ -25,7 +25,7 @@ import numpy as np
 from bgr.grammar.errors import BgrError, Diagnostic
 from bgr.interpreter.limits import check_memory
 
-from .model import EPS, MAX_CHILDREN, PAIRS_AT_ONCE, Box
+from .model import EPS, MAX_CHILDREN, PAIRS_AT_ONCE, Box, shown
 
 SPARSE_COST = 30  # a product of a sparse product costs about as much as 30 of a dense one
 PAIR_BYTES = 16  # what the n x n arrays of a node's analysis cost per pair of its children
@@ -221,12 +221,13 @@ def analyse_node(box: Box, axis: int) -> NodeAnalysis:
                 "",
                 0,
                 0,
-                f"along {'xyz'[axis]}, box '{box.id}' has {n:,} children (with the copies made "
-                f"along an earlier axis), more than the {MAX_CHILDREN:,} bgr analyses in one box",
+                f"along {'xyz'[axis]}, box '{shown(box.id)}' has {n:,} children (with the copies "
+                f"made along an earlier axis), more than the {MAX_CHILDREN:,} bgr analyses in one "
+                "box",
                 "ask a smaller size, or another --order, so that fewer copies are made first",
             )
         )
-    check_memory(f"analysing the {n:,} children of box '{box.id}'", n * n * PAIR_BYTES)
+    check_memory(f"analysing the {n:,} children of box '{shown(box.id)}'", n * n * PAIR_BYTES)
     lo = np.array([c.lo for c in kids])
     hi = np.array([c.hi for c in kids])
     tags = [c.tags[axis] for c in kids]

@@ -12,10 +12,9 @@ from __future__ import annotations
 
 from bgr.grammar import nodes as n
 from bgr.grammar.errors import Diagnostic
-from bgr.grammar.safe_text import comment_text
 from bgr.interpreter.limits import DEFAULT_MAX_DEPTH
 
-from .model import EPS, Box
+from .model import EPS, Box, shown
 
 MAX_DEPTH = DEFAULT_MAX_DEPTH  # bgr derive's --max-depth: the grammar must derive within it
 
@@ -66,11 +65,6 @@ def deep_message(depth: int | None) -> Diagnostic:
         f"limit of {MAX_DEPTH}",
         "flatten the hierarchy (fewer levels of boxes, or fewer slabs of several boxes)",
     )
-
-
-def shown(text: str, most: int = 60) -> str:
-    """An id as a message shows it: control characters escaped, at most ``most`` characters."""
-    return comment_text(text, most)  # the same escaping as the grammar's comments
 
 
 def rule_depth(module: n.Module) -> int:

@@ -19,7 +19,7 @@ import numpy as np
 
 from bgr.grammar.errors import BgrError, Diagnostic
 from bgr.grammar.paths import read_input
-from bgr.grammar.safe_text import unwritable
+from bgr.grammar.safe_text import comment_text, unwritable
 
 AXES = "xyz"
 BEHAVIOURS = ("S", "R", "F")
@@ -35,6 +35,12 @@ PAIRS_AT_ONCE = 1 << 20  # pairs of boxes compared in one numpy step (24 MB of f
 FORMAT = '{"root": {"id": ..., "min": [x, y, z], "max": [x, y, z], "children": [...]}}'
 MESH_PATH, MESH_NAME = 4096, 255  # a mesh path's characters and a name's bytes (PATH_MAX, NAME_MAX)
 READS = f"a boxes file is a JSON object {FORMAT} (docs/inverse-boxes.md)"
+
+
+def shown(text: str, most: int = 60) -> str:
+    """An id as a message shows it: control characters escaped, at most ``most`` characters
+    (an id of 100,000 characters is legal, but not worth printing)."""
+    return comment_text(text, most)  # the same escaping as the grammar's comments
 
 
 def _fail(
@@ -211,9 +217,9 @@ def _box(obj, name: str, where: str, ids: dict, fixed: tuple[bool, bool, bool]) 
     box_id = obj.get("id")
     if not isinstance(box_id, str) or not box_id.strip():
         raise _fail(name, f'{where} has no "id" (a non-empty string)')
-    here = f"box '{box_id}'"
+    here = f"box '{shown(box_id)}'"
     if box_id in ids:
-        raise _fail(name, f"two boxes have the id '{box_id}' ({ids[box_id]} and {where})")
+        raise _fail(name, f"two boxes have the id '{shown(box_id)}' ({ids[box_id]} and {where})")
     ids[box_id] = where
     unknown = set(obj) - {"id", "min", "max", "behavior", "mesh", "children", "source", "replica"}
     if unknown:
@@ -289,7 +295,8 @@ def _box(obj, name: str, where: str, ids: dict, fixed: tuple[bool, bool, bool]) 
     if not isinstance(replica, int) or isinstance(replica, bool) or replica < 0:
         raise _fail(name, f'{here}: "replica" must be a whole number, 0 or more')
     now = (tags[0] == "F", tags[1] == "F", tags[2] == "F")
-    kids = [_box(c, name, f"child {k} of '{box_id}'", ids, now) for k, c in enumerate(children)]
+    parent = shown(box_id)
+    kids = [_box(c, name, f"child {k} of '{parent}'", ids, now) for k, c in enumerate(children)]
     return Box(box_id, lo, hi, (tags[0], tags[1], tags[2]), mesh, kids, source, replica)
 
 
@@ -319,7 +326,7 @@ def check_sizes(
         if max_children is not None and len(box.children) > max_children:
             raise _fail(
                 name,
-                f"box '{box.id}' has {len(box.children):,} children, more than the "
+                f"box '{shown(box.id)}' has {len(box.children):,} children, more than the "
                 f"{max_children:,} bgr analyses in one box",
                 "group them into boxes of their own (a row, a floor, a bay): the analysis "
                 "compares every two children of a box",
@@ -338,16 +345,17 @@ def check(root: Box, eps: float = EPS) -> list[str]:
     problems = []
     for box in root.walk():
         if np.any(box.hi - box.lo < -eps):
-            problems.append(f"box '{box.id}' has a negative size")
+            problems.append(f"box '{shown(box.id)}' has a negative size")
         for child in box.children:
             if np.any(child.lo < box.lo - eps) or np.any(child.hi > box.hi + eps):
-                problems.append(f"box '{child.id}' is not inside its parent '{box.id}'")
+                inside = f"is not inside its parent '{shown(box.id)}'"
+                problems.append(f"box '{shown(child.id)}' {inside}")
         if len(box.children) > 1:
             lo = np.array([c.lo for c in box.children])
             hi = np.array([c.hi for c in box.children])
             for i, j in overlapping(lo, hi, eps):
                 a, b = box.children[i], box.children[j]
-                problems.append(f"boxes '{a.id}' and '{b.id}' overlap")
+                problems.append(f"boxes '{shown(a.id)}' and '{shown(b.id)}' overlap")
     return problems
 
 

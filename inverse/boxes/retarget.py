@@ -36,7 +36,7 @@ from bgr.grammar.errors import BgrError, Diagnostic
 from bgr.interpreter.limits import check_memory
 
 from .analysis import Analysis, Sequence, Unit, analyse, min_length
-from .model import AXES, EPS, MAX_BOXES, Box
+from .model import AXES, EPS, MAX_BOXES, Box, shown
 from .repair import RHO, Layout, Placed, fit, fits, valid
 
 BOX_BYTES = 1000  # what a copy of a box costs (625 bytes measured) and its place in the output
@@ -81,7 +81,7 @@ def retarget_axis(
                 "",
                 0,
                 0,
-                f"box '{root.id}' is fixed (F) along {name}: it stays {now:g} m",
+                f"box '{shown(root.id)}' is fixed (F) along {name}: it stays {now:g} m",
                 f"give --size with {now:g} for {name}, or tag the root S",
             )
         )

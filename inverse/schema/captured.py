@@ -311,7 +311,7 @@ def _where(parts) -> str:
         elif re.match(r"^[A-Za-z_][A-Za-z0-9_]*$", p):
             out += f".{p}" if out else p
         else:
-            out += f"[{json.dumps(p)}]"
+            out += f"[{_show(p)}]"  # a 10,000-character key is cut
     return out
 
 
