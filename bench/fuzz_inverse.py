@@ -326,7 +326,9 @@ def run_case(argv: list[str], folder: Path, timeout: float = TIMEOUT_S,
     if code == 0:
         return Outcome("success", seconds, stderr)
     if code == 1 and stderr.strip():
-        return Outcome("error", seconds, stderr)
+        # located: the message starts with the input file (FILE:LINE:COL: or FILE: ...)
+        located = stderr.lstrip().startswith(argv[1]) if len(argv) > 1 else True
+        return Outcome("error" if located else "unlocated error", seconds, stderr)
     return Outcome(f"exit {code}", seconds, stderr)
 
 
@@ -382,7 +384,8 @@ def _worker(seeds, surfaces, cases, base_seed, part, parts, out: Path) -> None:
 
 def _cases(seeds, surfaces, cases, base_seed, part, parts, out: Path, tmp: Path) -> None:
     with open(out / f"results-{part}.jsonl", "w") as log:
-        for index in range(part, cases, parts):  # every surface in turn: a cut run covers all
+        # every surface in turn: a cut run covers all
+        for index in range(cases.start + part, cases.stop, parts):
             for surface in surfaces:
                 seed, data, argv, outcome = fuzz_case(seeds[surface], index, base_seed, tmp)
                 row = {"surface": surface, "index": index, "kind": outcome.kind,
@@ -429,6 +432,12 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--cases", type=int, default=200, help="cases per surface (200)")
     parser.add_argument("--surface", action="append", choices=SURFACES, help="default: all")
     parser.add_argument("--seed", type=int, default=0, help="the mutations' seed (0)")
+    parser.add_argument(
+        "--first-case",
+        type=int,
+        default=0,
+        help="index of the first case (0): a long run may be done in parts, 0-4999 then 5000-9999",
+    )
     parser.add_argument("--workers", type=int, default=2, help="forking workers (2)")
     parser.add_argument("--out", type=Path, default=None, help="results and failures folder")
     args = parser.parse_args(argv)
@@ -449,7 +458,8 @@ def main(argv: list[str] | None = None) -> int:
         if pid == 0:
             code = 0
             try:
-                _worker(seeds, surfaces, args.cases, args.seed, part, args.workers, out)
+                cases = range(args.first_case, args.first_case + args.cases)
+                _worker(seeds, surfaces, cases, args.seed, part, args.workers, out)
             except BaseException:  # noqa: BLE001
                 import traceback
 
