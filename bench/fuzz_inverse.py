@@ -308,7 +308,8 @@ def run_case(argv: list[str], folder: Path, timeout: float = TIMEOUT_S,
     status = _wait(pid, timeout)
     seconds = time.perf_counter() - start
     err_path = folder / "stderr.txt"
-    stderr = err_path.read_text(errors="replace")[-4000:] if err_path.exists() else ""
+    whole = err_path.read_text(errors="replace") if err_path.exists() else ""
+    stderr = whole[-4000:]
     if status is None:
         return Outcome("timeout", seconds, stderr)
     if os.WIFSIGNALED(status):
@@ -327,7 +328,7 @@ def run_case(argv: list[str], folder: Path, timeout: float = TIMEOUT_S,
         return Outcome("success", seconds, stderr)
     if code == 1 and stderr.strip():
         # located: the message starts with the input file (FILE:LINE:COL: or FILE: ...)
-        located = stderr.lstrip().startswith(argv[1]) if len(argv) > 1 else True
+        located = whole.lstrip().startswith(argv[1]) if len(argv) > 1 else True
         return Outcome("error" if located else "unlocated error", seconds, stderr)
     return Outcome(f"exit {code}", seconds, stderr)
 

@@ -289,3 +289,31 @@ def test_a_cityjson_surface_listed_3000_times_is_read_once(tmp_path):
     assert scene.triangles == 4  # the floor's two triangles and the wall's two
     outcome = _run(tmp_path, ["infer", "c.city.json", "-o", "out.bgr"])
     assert outcome.kind == "success", outcome.stderr
+
+
+def test_copies_past_the_pairs_budget_are_refused_before_the_analysis(tmp_path):
+    """building.json scaled by 1e-3 and retargeted to 12 x 9 x 30 m: x made four boxes of
+    4,000 copies each (60 million pairs of siblings), whose analysis along y took 7 s (10 under
+    load) before the result was refused as too large; it is refused before the analysis."""
+    from bgr.grammar.errors import BgrError
+    from bgr.inverse.boxes.analysis import analyse
+    from bgr.inverse.boxes.model import MAX_PAIRS, read
+    from bgr.inverse.boxes.retarget import retarget_axis
+
+    doc = json.loads((ROOT / "examples/boxes/building.json").read_text())
+
+    def scale(box: dict) -> None:
+        box["min"] = [v / 1000 for v in box["min"]]
+        box["max"] = [v / 1000 for v in box["max"]]
+        box.pop("mesh", None)
+        for child in box["children"]:
+            scale(child)
+
+    scale(doc["root"])
+    _write(tmp_path, "b.json", json.dumps(doc))
+    root = retarget_axis(read(tmp_path / "b.json"), 0, 12.0)
+    assert sum(len(b.children) ** 2 for b in root.walk()) > MAX_PAIRS
+    with pytest.raises(BgrError, match="pairs of sibling boxes"):
+        analyse(root, 1)
+    outcome = _run(tmp_path, ["retarget", "b.json", "--size", "12,9,30", "-o", "out.bgr"])
+    assert outcome.kind == "error" and "would compare" in outcome.stderr, outcome.stderr

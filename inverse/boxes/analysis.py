@@ -25,7 +25,7 @@ import numpy as np
 from bgr.grammar.errors import BgrError, Diagnostic
 from bgr.interpreter.limits import check_memory
 
-from .model import EPS, MAX_CHILDREN, PAIRS_AT_ONCE, Box, shown
+from .model import EPS, MAX_CHILDREN, MAX_PAIRS, PAIRS_AT_ONCE, Box, shown
 
 SPARSE_COST = 30  # a product of a sparse product costs about as much as 30 of a dense one
 PAIR_BYTES = 16  # what the n x n arrays of a node's analysis cost per pair of its children
@@ -89,7 +89,23 @@ class Analysis:
 
 
 def analyse(root: Box, axis: int) -> Analysis:
-    """Alignment groups, compatibility graphs and sequences of every node along ``axis``."""
+    """Alignment groups, compatibility graphs and sequences of every node along ``axis``; a
+    BgrError, before any work, when that would compare more than MAX_PAIRS pairs of siblings."""
+    counts = [len(box.children) for box in root.walk()]
+    pairs = sum(n * n for n in counts)
+    if pairs > MAX_PAIRS and max(counts) <= MAX_CHILDREN:  # (one box over: analyse_node says)
+        raise BgrError(
+            Diagnostic(
+                "",
+                0,
+                0,
+                f"along {'xyz'[axis]}, analysing these boxes would compare {pairs:,} pairs of "
+                f"sibling boxes (with any copies made along an earlier axis), more than the "
+                f"{MAX_PAIRS:,} bgr compares along one axis",
+                "ask a smaller size, or another --order, so that fewer copies are made first; "
+                "or give the boxes fewer children each",
+            )
+        )
     result = Analysis(axis, alignment_groups(root, axis))
     for box in root.walk():
         if box.children:

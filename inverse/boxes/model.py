@@ -31,6 +31,11 @@ input or among the copies an axis retargeted first has made.  The analysis compa
 children of a box along each axis (16 bytes a pair, and in a tower a matrix product): 4,000
 children cost 250 MB and 2 to 6 s an axis; 10,000 asked for 12 GB before this limit.  No
 modelled building comes near it (docs/limits.md)."""
+MAX_PAIRS = MAX_CHILDREN**2
+"""Pairs of sibling boxes the analysis compares along one axis, over all boxes together: as many
+as one box at MAX_CHILDREN.  A box retargeted first along x to 500 times its size held four
+boxes of 4,000 copies each (60 million pairs): the analysis along y took 7 s before the result
+was refused as too large."""
 PAIRS_AT_ONCE = 1 << 20  # pairs of boxes compared in one numpy step (24 MB of float64 each)
 FORMAT = '{"root": {"id": ..., "min": [x, y, z], "max": [x, y, z], "children": [...]}}'
 MESH_PATH, MESH_NAME = 4096, 255  # a mesh path's characters and a name's bytes (PATH_MAX, NAME_MAX)
