@@ -360,7 +360,9 @@ def fuzz_case(seeds: list[Seed], index: int, base_seed: int, tmp: Path) -> Case:
     return run_mutant(seeds, rng, folder)
 
 
-def run_mutant(seeds: list[Seed], rng: random.Random, folder: Path) -> Case:
+def run_mutant(
+    seeds: list[Seed], rng: random.Random, folder: Path, timeout: float = TIMEOUT_S
+) -> Case:
     """A mutant of one of ``seeds`` (drawn by ``rng``) written to ``folder`` and run there."""
     seed = rng.choice(seeds)
     data = mutant(rng, seed.surface, seed.data)
@@ -368,7 +370,7 @@ def run_mutant(seeds: list[Seed], rng: random.Random, folder: Path) -> Case:
     for name, extra in seed.extra.items():
         (folder / name).write_bytes(extra)
     argv = command(seed.surface, seed.name, rng)
-    return seed, data, argv, run_case(argv, folder)
+    return seed, data, argv, run_case(argv, folder, timeout)
 
 
 # ---------------------------------------------------------------- the run
