@@ -201,7 +201,7 @@ def command(surface: str, name: str, rng: random.Random) -> list[str]:
     if surface == "boxes":
         if rng.random() < 0.5:
             return ["retarget", name, "--size", rng.choice(("12,9,30", "3,3,3", "40,2,8")),
-                    "-o", "out.bgr"]  # fmt: skip
+                    "-o", rng.choice(("out.json", "out.glb"))]  # fmt: skip
         return ["infer", name, "--kind", "boxes", "-o", "out.bgr"]
     if surface == "captured":
         return ["infer", name, "--kind", "schema", "-o", "out.bgr"]
@@ -327,8 +327,9 @@ def run_case(argv: list[str], folder: Path, timeout: float = TIMEOUT_S,
     if code == 0:
         return Outcome("success", seconds, stderr)
     if code == 1 and stderr.strip():
-        # located: the message starts with the input file (FILE:LINE:COL: or FILE: ...)
-        located = whole.lstrip().startswith(argv[1]) if len(argv) > 1 else True
+        # located: the message starts with the input or the output file (FILE:LINE:COL: ...)
+        files = [argv[1], *(argv[k + 1] for k, a in enumerate(argv[:-1]) if a == "-o")]
+        located = whole.lstrip().startswith(tuple(files)) if len(argv) > 1 else True
         return Outcome("error" if located else "unlocated error", seconds, stderr)
     return Outcome(f"exit {code}", seconds, stderr)
 

@@ -332,3 +332,36 @@ def test_copies_past_the_pairs_budget_are_refused_before_the_analysis(tmp_path):
         analyse(root, 1)
     outcome = _run(tmp_path, ["retarget", "b.json", "--size", "12,9,30", "-o", "out.bgr"])
     assert outcome.kind == "error" and "would compare" in outcome.stderr, outcome.stderr
+
+
+def test_many_small_parents_are_refused_before_the_analysis(tmp_path):
+    """regular_facade.json at 1/1000 of its size retargeted to 3 m made 12,006 boxes with
+    children along x, whose analysis along y took 17 s (a timeout in the long run) before the
+    result was refused as too large: each costs about a millisecond however few its children.
+    More than MAX_PARENTS are refused before the analysis: here 3,001 bays of two children."""
+    from bgr.inverse.boxes.model import MAX_PARENTS
+
+    def bay(k: int) -> dict:
+        halves = [{"id": f"b{k}-{h}", "min": [k, h, 0], "max": [k + 1, h + 1, 1], "children": []}
+                  for h in (0, 1)]  # fmt: skip
+        return {"id": f"b{k}", "min": [k, 0, 0], "max": [k + 1, 2, 1], "children": halves}
+
+    n = MAX_PARENTS  # with the root: one more than the limit
+    root = {"id": "row", "min": [0, 0, 0], "max": [n, 2, 1], "children": [bay(k) for k in range(n)]}
+    _write(tmp_path, "f.json", json.dumps({"root": root}))
+    outcome = _run(tmp_path, ["retarget", "f.json", "--size", f"{n},3,1", "-o", "out.json"])
+    assert outcome.kind == "error", outcome.stderr
+    assert f"{n + 1:,} boxes have children to analyse" in outcome.stderr, outcome.stderr
+
+
+def test_an_output_retarget_cannot_write_is_refused_before_the_work(tmp_path):
+    """`bgr retarget building.json -o out.bgr` did the whole retargeting, then said that it
+    cannot write .bgr; it says so first."""
+    (tmp_path / "parts").mkdir()
+    _write(tmp_path, "b.json", (ROOT / "examples/boxes/building.json").read_text())
+    for part in (ROOT / "examples/boxes/parts").iterdir():
+        _write(tmp_path / "parts", part.name, part.read_bytes())
+    outcome = _run(tmp_path, ["retarget", "b.json", "--size", "4000,9,30", "-o", "out.bgr"])
+    assert outcome.kind == "unlocated error" or outcome.kind == "error", outcome.stderr
+    assert outcome.stderr.startswith("out.bgr: error: unknown output extension '.bgr'")
+    assert outcome.seconds < 3 and not (tmp_path / "out.bgr").exists()

@@ -25,7 +25,7 @@ import numpy as np
 from bgr.grammar.errors import BgrError, Diagnostic
 from bgr.interpreter.limits import check_memory
 
-from .model import EPS, MAX_CHILDREN, MAX_PAIRS, PAIRS_AT_ONCE, Box, shown
+from .model import EPS, MAX_CHILDREN, MAX_PAIRS, MAX_PARENTS, PAIRS_AT_ONCE, Box, shown
 
 SPARSE_COST = 30  # a product of a sparse product costs about as much as 30 of a dense one
 PAIR_BYTES = 16  # what the n x n arrays of a node's analysis cost per pair of its children
@@ -91,7 +91,19 @@ class Analysis:
 def analyse(root: Box, axis: int) -> Analysis:
     """Alignment groups, compatibility graphs and sequences of every node along ``axis``; a
     BgrError, before any work, when that would compare more than MAX_PAIRS pairs of siblings."""
-    counts = [len(box.children) for box in root.walk()]
+    counts = [len(box.children) for box in root.walk() if box.children]
+    if len(counts) > MAX_PARENTS:
+        raise BgrError(
+            Diagnostic(
+                "",
+                0,
+                0,
+                f"along {'xyz'[axis]}, {len(counts):,} boxes have children to analyse (with any "
+                f"copies made along an earlier axis), more than the {MAX_PARENTS:,} bgr analyses "
+                "along one axis",
+                "ask a smaller size, or another --order, so that fewer copies are made first",
+            )
+        )
     pairs = sum(n * n for n in counts)
     if pairs > MAX_PAIRS and max(counts) <= MAX_CHILDREN:  # (one box over: analyse_node says)
         raise BgrError(

@@ -47,6 +47,10 @@ def run_retarget(args) -> int:
         print(f"bgr retarget: {terminal_text(str(getattr(e, 'message', e)))}", file=sys.stderr)
         return USAGE
     out = None if args.output in (None, "-") else Path(args.output)
+    if out is not None and not (out.name.lower().endswith(".json") and not _mesh_json(out)):
+        from bgr.formats import format_of
+
+        format_of(out)  # an output bgr cannot write is refused before the work, not after it
     source = Path(args.input)
     restart_memory()  # the ceiling (--max-memory) counts from here, the modules loaded
     # refused here when too large to analyse, before any work on pairs of boxes
