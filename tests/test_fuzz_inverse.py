@@ -245,7 +245,7 @@ def test_boxes_integer_of_400_digits_is_a_clean_error(tmp_path):
     doc = json.loads((ROOT / "examples/boxes/building.json").read_text())
     doc["root"]["min"][0] = 10**400
     _write(tmp_path, "b.json", json.dumps(doc))
-    outcome = _run(tmp_path, ["retarget", "b.json", "--size", "12,9,30", "-o", "out.bgr"])
+    outcome = _run(tmp_path, ["retarget", "b.json", "--size", "12,9,30", "-o", "out.json"])
     assert outcome.kind == "error" and "beyond 1e9 m" in outcome.stderr, outcome.stderr
 
 
@@ -330,7 +330,7 @@ def test_copies_past_the_pairs_budget_are_refused_before_the_analysis(tmp_path):
     assert sum(len(b.children) ** 2 for b in root.walk()) > MAX_PAIRS
     with pytest.raises(BgrError, match="pairs of sibling boxes"):
         analyse(root, 1)
-    outcome = _run(tmp_path, ["retarget", "b.json", "--size", "12,9,30", "-o", "out.bgr"])
+    outcome = _run(tmp_path, ["retarget", "b.json", "--size", "12,9,30", "-o", "out.json"])
     assert outcome.kind == "error" and "would compare" in outcome.stderr, outcome.stderr
 
 
@@ -382,3 +382,23 @@ def test_a_gltf_primitive_listed_3000_times_is_read_once(tmp_path):
     gltf["meshes"][0]["primitives"] *= 3000
     again = world_mesh(gltf, blob, scene_roots(gltf))
     assert len(again.faces) == len(one.faces) == 12
+
+
+def test_the_budgets_come_before_min_length(monkeypatch):
+    """regular_facade.json at 1/1000 of its size retargeted to 40 x 2 x 8 m: x made a box of
+    13,334 copies, and min_length along y walked them for 8 s before the analysis refused
+    them (a timeout in the long run); the budgets are checked before min_length."""
+    from bgr.grammar.errors import BgrError
+    from bgr.inverse.boxes import retarget as retarget_module
+    from bgr.inverse.boxes.model import MAX_CHILDREN, Box
+
+    n = MAX_CHILDREN + 1
+    kids = [Box(f"k{i}", np.array([i, 0, 0.0]), np.array([i + 1, 1, 1.0])) for i in range(n)]
+    root = Box("row", np.zeros(3), np.array([n, 1, 1.0]), children=kids)
+
+    def walked(*args):
+        raise AssertionError("min_length ran before the budgets")
+
+    monkeypatch.setattr(retarget_module, "min_length", walked)
+    with pytest.raises(BgrError, match=f"has {MAX_CHILDREN + 1:,} children"):
+        retarget_module.retarget_axis(root, 1, 2.0)

@@ -90,8 +90,23 @@ class Analysis:
 
 def analyse(root: Box, axis: int) -> Analysis:
     """Alignment groups, compatibility graphs and sequences of every node along ``axis``; a
-    BgrError, before any work, when that would compare more than MAX_PAIRS pairs of siblings."""
-    counts = [len(box.children) for box in root.walk() if box.children]
+    BgrError, before any work, when :func:`check_analysable` refuses the hierarchy."""
+    check_analysable(root, axis)
+    result = Analysis(axis, alignment_groups(root, axis))
+    for box in root.walk():
+        if box.children:
+            result.nodes[id(box)] = analyse_node(box, axis)
+    return result
+
+
+def check_analysable(root: Box, axis: int) -> None:
+    """Refuse, before any work along ``axis`` (the analysis, min_length), a hierarchy of more
+    than MAX_PARENTS boxes with children or MAX_PAIRS pairs of siblings to compare."""
+    parents = [box for box in root.walk() if box.children]
+    widest = max(parents, key=lambda box: len(box.children), default=None)
+    if widest is not None and len(widest.children) > MAX_CHILDREN:
+        raise _too_many_children(widest, axis)
+    counts = [len(box.children) for box in parents]
     if len(counts) > MAX_PARENTS:
         raise BgrError(
             Diagnostic(
@@ -105,7 +120,7 @@ def analyse(root: Box, axis: int) -> Analysis:
             )
         )
     pairs = sum(n * n for n in counts)
-    if pairs > MAX_PAIRS and max(counts) <= MAX_CHILDREN:  # (one box over: analyse_node says)
+    if pairs > MAX_PAIRS:
         raise BgrError(
             Diagnostic(
                 "",
@@ -118,11 +133,6 @@ def analyse(root: Box, axis: int) -> Analysis:
                 "or give the boxes fewer children each",
             )
         )
-    result = Analysis(axis, alignment_groups(root, axis))
-    for box in root.walk():
-        if box.children:
-            result.nodes[id(box)] = analyse_node(box, axis)
-    return result
 
 
 def alignment_groups(root: Box, axis: int) -> dict[int, list[float]]:
@@ -240,21 +250,25 @@ def _nothing_between(under: np.ndarray) -> np.ndarray:
     return out
 
 
+def _too_many_children(box: Box, axis: int) -> BgrError:
+    return BgrError(
+        Diagnostic(
+            "",
+            0,
+            0,
+            f"along {'xyz'[axis]}, box '{shown(box.id)}' has {len(box.children):,} children (with "
+            f"the copies made along an earlier axis), more than the {MAX_CHILDREN:,} bgr analyses "
+            "in one box",
+            "ask a smaller size, or another --order, so that fewer copies are made first",
+        )
+    )
+
+
 def analyse_node(box: Box, axis: int) -> NodeAnalysis:
     kids = box.children
     n = len(kids)
     if n > MAX_CHILDREN:  # the commands refuse such an input: these are copies
-        raise BgrError(
-            Diagnostic(
-                "",
-                0,
-                0,
-                f"along {'xyz'[axis]}, box '{shown(box.id)}' has {n:,} children (with the copies "
-                f"made along an earlier axis), more than the {MAX_CHILDREN:,} bgr analyses in one "
-                "box",
-                "ask a smaller size, or another --order, so that fewer copies are made first",
-            )
-        )
+        raise _too_many_children(box, axis)
     check_memory(f"analysing the {n:,} children of box '{shown(box.id)}'", n * n * PAIR_BYTES)
     lo = np.array([c.lo for c in kids])
     hi = np.array([c.hi for c in kids])

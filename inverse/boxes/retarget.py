@@ -35,7 +35,7 @@ import numpy as np
 from bgr.grammar.errors import BgrError, Diagnostic
 from bgr.interpreter.limits import check_memory
 
-from .analysis import Analysis, Sequence, Unit, analyse, min_length
+from .analysis import Analysis, Sequence, Unit, analyse, check_analysable, min_length
 from .model import AXES, EPS, MAX_BOXES, Box, shown
 from .repair import RHO, Layout, Placed, fit, fits, valid
 
@@ -85,6 +85,7 @@ def retarget_axis(
                 f"give --size with {now:g} for {name}, or tag the root S",
             )
         )
+    check_analysable(root, axis)  # min_length below walks the same pairs as the analysis
     shortest = min_length(root, axis)
     if length < shortest - EPS:
         raise BgrError(
