@@ -307,9 +307,10 @@ def test_a_cityjson_surface_listed_3000_times_is_read_once(tmp_path):
 
 
 def test_copies_past_the_pairs_budget_are_refused_before_the_analysis(tmp_path):
-    """building.json scaled by 1e-3 and retargeted to 12 x 9 x 30 m: x made four boxes of
-    4,000 copies each (60 million pairs of siblings), whose analysis along y took 7 s (10 under
-    load) before the result was refused as too large; it is refused before the analysis."""
+    """building.json scaled by 1e-3 and retargeted to 12 x 9 x 30 m: x made three boxes of
+    4,000 copies and two of 2,399 (60 million pairs of siblings), whose analysis along y took
+    7 s (10 under load) before the result was refused as too large; it is refused before the
+    analysis."""
     from bgr.grammar.errors import BgrError
     from bgr.inverse.boxes.analysis import analyse
     from bgr.inverse.boxes.model import MAX_PAIRS, read

@@ -33,14 +33,14 @@ children cost 250 MB and 2 to 6 s an axis; 10,000 asked for 12 GB before this li
 modelled building comes near it (docs/limits.md)."""
 MAX_PAIRS = MAX_CHILDREN**2
 """Pairs of sibling boxes the analysis compares along one axis, over all boxes together: as many
-as one box at MAX_CHILDREN.  A box retargeted first along x to 500 times its size held four
-boxes of 4,000 copies each (60 million pairs): the analysis along y took 7 s before the result
-was refused as too large."""
+as one box at MAX_CHILDREN.  A box retargeted first along x to 500 times its size held three
+boxes of 4,000 copies and two of 2,399 (60 million pairs): the analysis along y took 7 s before
+the result was refused as too large."""
 MAX_PARENTS = 3_000
 """Boxes with children that the analysis of one axis goes through: each costs about a
 millisecond however few its children.  A facade at 1/1000 of its size retargeted to 3 m made
 12,006 of them along x (44,022 boxes), whose analysis along y took 17 s before the result was
-refused as too large; the examples have 10 to 40."""
+refused as too large; the examples have 1 to 9."""
 PAIRS_AT_ONCE = 1 << 20  # pairs of boxes compared in one numpy step (24 MB of float64 each)
 FORMAT = '{"root": {"id": ..., "min": [x, y, z], "max": [x, y, z], "children": [...]}}'
 MESH_PATH, MESH_NAME = 4096, 255  # a mesh path's characters and a name's bytes (PATH_MAX, NAME_MAX)
