@@ -636,6 +636,29 @@ def test_too_many_boxes_are_refused_quickly(tmp_path, capsys):
     assert code == 0 and len(list(model.read(out).walk())) == 9_003
 
 
+def test_a_result_over_max_boxes_is_refused_before_any_copy_is_made(monkeypatch):
+    # forty storeys each repeated 30 times: no one repeat passes the limit, all of them do; the
+    # walk is counted first, so the refusal comes before the first copy (4 s of copies before)
+    storeys = [
+        box(f"s{k}", (0, k, 0), (1, k + 1, 1), "RSS", [box(f"w{k}", (0.2, k, 0), (0.8, k + 1, 1))])
+        for k in range(40)
+    ]
+    from bgr.inverse.boxes import retarget as retargeting
+
+    root = parse(box("r", (0, 0, 0), (1, 40, 1), "SSS", storeys))
+    made = []
+    real = retargeting.Retargeter.replicate
+    monkeypatch.setattr(
+        retargeting.Retargeter, "replicate", lambda self, *a: made.append(1) or real(self, *a)
+    )
+    with pytest.raises(BgrError, match="more than 2,000 boxes"):
+        retarget_axis(root, 0, 30.0, max_boxes=2_000)
+    assert made == []
+    assert len(list(root.walk())) == 81  # the counting walk was undone
+    assert len(list(retarget_axis(root, 0, 30.0, max_boxes=3_000).walk())) == 1 + 40 * 2 * 30
+    assert len(made) == 40 * 29
+
+
 def test_ids_with_a_tilde_count_their_alignments():
     # the input may use "~" in its ids: its boxes are not taken for copies
     kids = [box("w~1", (0, 0, 0), (2, 4, 1)), box("door~a", (2, 0, 0), (4, 4, 1), "FSS")]

@@ -91,7 +91,7 @@ def retarget_axis(
         raise BgrError(
             f"the fixed boxes along {name} need at least {shortest:g} m; {length:g} m is shorter"
         )
-    Retargeter(root, axis, analysis or analyse(root, axis), max_boxes).resize(
+    Retargeter(root, axis, analysis or analyse(root, axis), max_boxes).run(
         root, float(root.lo[axis]), float(root.lo[axis]) + length
     )
     return root
@@ -113,6 +113,28 @@ class Retargeter:
         self.copied: dict[str, int] = {}  # source id -> the last copy number its ids used
         self.boxes = len(self.taken)  # boxes in the result so far
         self.look_at = self.boxes + LOOK_EVERY  # the count at which memory is measured next
+        self.copying = True  # False while counting: fill() counts its copies but makes none
+
+    def run(self, root: Box, lo: float, hi: float) -> None:
+        """Resize ``root`` to ``[lo, hi]``, counting the result first.
+
+        The walk is done once without its copies and undone, so a result over ``max_boxes`` or
+        ``--max-memory`` is refused before any copy is made, leaving ``root`` as it was.  The
+        copies are most of the work (a result refused at 200,000 boxes spent 4 s copying before
+        it was counted); the walk without them is a few percent of it."""
+        a = self.axis
+        saved = [(b, float(b.lo[a]), float(b.hi[a]), b.children) for b in root.walk()]
+        start = self.boxes
+        self.copying = False
+        try:
+            self.resize(root, lo, hi)
+            made = self.boxes - start
+        finally:  # a refused result leaves the input as it was
+            for b, was_lo, was_hi, children in saved:
+                b.lo[a], b.hi[a], b.children = was_lo, was_hi, children
+        self.boxes, self.aligned, self.copying = start, {}, True
+        check_memory(f"retargeting along {AXES[a]} ({start + made:,} boxes)", BOX_BYTES * made)
+        self.resize(root, lo, hi)
 
     # ---- alignment ---------------------------------------------------------------------
     def group(self, position: float) -> int | None:
@@ -127,14 +149,15 @@ class Retargeter:
             self.aligned[g] = new
 
     # ---- the walk ----------------------------------------------------------------------
-    def resize(self, box: Box, lo: float, hi: float) -> None:
+    def resize(self, box: Box, lo: float, hi: float) -> int:
+        """Resize ``box`` to ``[lo, hi]`` along the axis; the boxes its subtree then holds."""
         a = self.axis
         if box.tags[a] == "F":
             box.shift(a, lo - box.lo[a])
-            return
+            return sum(1 for _ in box.walk())
         if not box.children:
             box.lo[a], box.hi[a] = lo, hi
-            return
+            return 1
         node = self.analysis.of(box)
         kids = box.children
         old_lo = np.array([c.lo[a] for c in kids])
@@ -155,6 +178,7 @@ class Retargeter:
         box.lo[a], box.hi[a] = lo, hi
         placed: dict[int, Placed] = {}
         copies: dict[int, list[Box]] = {}
+        grown: dict[int, int] = {}  # child -> the boxes it and its copies hold after resizing
         room = self.room(kids, node.touch, old_lo)
         self.pin(kids, node.touch, old_lo, old_hi, ends, (lo, hi))
         fitting = True  # no child placed out of the node or below its minimum so far
@@ -166,7 +190,7 @@ class Retargeter:
                     p.count = 0  # squeezed to nothing: deleted, as a contraction deletes
                 fitting = fitting and fits(layout, i, p)
                 if fitting:
-                    self.fill(kids, i, p, copies)
+                    grown[i] = self.fill(kids, i, p, copies)
         slots = [placed[i] for i in range(len(kids))]
         if not (fitting and valid(layout, slots)):
             # the placement left boxes overlapping or outside: undo it and fit (repair.py)
@@ -178,25 +202,26 @@ class Retargeter:
                 if p.count == 0 and kids[i].tags[a] == "S":
                     p.count = 1  # squeezed by a placement that did not fit: may get room now
             slots = fit(layout, slots)
-            copies = {}
+            copies, grown = {}, {}
             for seq in node.sequences:
                 for i in seq.boxes:
                     p = slots[i]
                     if p.hi - p.lo <= EPS and kids[i].tags[a] != "F":
                         p.count = 0
-                    self.fill(kids, i, p, copies)
+                    grown[i] = self.fill(kids, i, p, copies)
         box.children = [
             b for i, k in enumerate(kids) if slots[i].count > 0 for b in [k, *copies[i]]
         ]
+        return 1 + sum(grown.values())
 
-    def fill(self, kids: list[Box], i: int, p: Placed, copies: dict[int, list[Box]]) -> None:
-        """Resize child ``i`` into its first copy's place and make the other copies."""
+    def fill(self, kids: list[Box], i: int, p: Placed, copies: dict[int, list[Box]]) -> int:
+        """Resize child ``i`` into its first copy's place and make the other copies (only
+        count them while counting); the boxes the child and its copies then hold."""
         copies[i] = []
         if p.count == 0:
-            return
+            return 0
         step = (p.hi - p.lo) / p.count
-        self.resize(kids[i], p.lo, p.lo + step)
-        size = sum(1 for _ in kids[i].walk())
+        size = self.resize(kids[i], p.lo, p.lo + step)
         self.boxes += size * (p.count - 1)
         if self.boxes > self.max_boxes:
             raise BgrError(
@@ -205,10 +230,13 @@ class Retargeter:
                     0,
                     0,
                     f"the result would have more than {self.max_boxes:,} boxes "
-                    f"('{kids[i].source}' repeated {p.count:,} times along {AXES[self.axis]})",
+                    f"('{shown(kids[i].source)}' repeated {p.count:,} times "
+                    f"along {AXES[self.axis]})",
                     "ask a smaller size, or raise --max-boxes",
                 )
             )
+        if not self.copying:
+            return size * p.count
         if self.boxes >= self.look_at:  # the copies are what grows: held to --max-memory
             check_memory(
                 f"retargeting along {AXES[self.axis]} ({self.boxes:,} boxes)",
@@ -216,6 +244,7 @@ class Retargeter:
             )
             self.look_at = self.boxes + LOOK_EVERY
         copies[i] = [self.replicate(kids[i], c * step, c) for c in range(1, p.count)]
+        return size * p.count
 
     def replicate(self, box: Box, by: float, number: int) -> Box:
         """Copy ``number`` of a resized box, ``by`` further along the axis, with fresh ids."""
