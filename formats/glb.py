@@ -516,7 +516,7 @@ class Scene:
             pieces += [b',"meshes":[', sp["meshes"], b"]"]
         if self.used:
             mats = self.materials.all()
-            materials = [
+            materials: list[dict] = [
                 {
                     "name": mats.labels[k],
                     "pbrMetallicRoughness": {
@@ -531,7 +531,7 @@ class Scene:
             ]
             for k, (color, normal) in enumerate(self.materials.textures):
                 if color is not None:
-                    pbr = materials[k]["pbrMetallicRoughness"]
+                    pbr: dict = materials[k]["pbrMetallicRoughness"]
                     pbr["baseColorTexture"] = {"index": self.images[color]}
                     if self.image_alpha.get(color):
                         materials[k]["alphaMode"] = "BLEND"
