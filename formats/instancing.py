@@ -62,6 +62,8 @@ def plan(
     )
     if instancing is False or instancing == "never" or n == 0:
         eligible[:] = False
+    if len(table.tex_rows):  # texture coordinates are each terminal's own: baked, not shared
+        eligible[np.asarray(table.tex_rows, dtype=np.int64)] = False
 
     n_mesh = max(len(pool.vcount), 1)
     if major is None:  # the file's grouping of rows (scene group and material); else material

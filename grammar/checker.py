@@ -32,16 +32,24 @@ from .registry import (
     FOOTPRINT_KINDS,
     GEOMETRY,
     KEYWORDS,
+    NORMALIZE_MODE,
+    NORMALIZE_MODES,
+    NORMALIZE_TYPE,
+    NORMALIZE_TYPES,
     NUMBER,
     OFFSET_SELECTORS,
     OPERATIONS,
     PRIMITIVES,
+    PROJECTION_AXES,
+    PROJECTION_AXES_NAMES,
     ROOF_KIND,
     ROOF_KINDS,
     SIZE,
     STRING,
+    TEX_SIZE,
     Op,
 )
+from .textures import TextureError, load
 
 KNOWN_VERSIONS = (1,)
 _COLOR_RE = re.compile(r"#[0-9a-fA-F]{6}\Z")
@@ -51,7 +59,11 @@ _SYMBOL_KINDS = {
     ROOF_KIND: ROOF_KINDS,
     FOOTPRINT_KIND: FOOTPRINT_KINDS,
     EXTRUDE_KIND: EXTRUDE_KINDS,
+    PROJECTION_AXES: PROJECTION_AXES_NAMES,
+    NORMALIZE_MODE: NORMALIZE_MODES,
+    NORMALIZE_TYPE: NORMALIZE_TYPES,
 }
+_TEXTURE_OPS = ("texture", "normalMap")
 _RESERVED_ALIASES = {"scope", "split", "comp", "stdlib", "geometry"}
 
 
@@ -483,16 +495,25 @@ class Checker:
                         suggest(word, known) or 'declare it: asset NAME = "path/to/mesh.glb"',
                     )
             return
-        if isinstance(arg, n.Relative) and kind != SIZE:
+        if isinstance(arg, n.Relative) and arg.floating and kind != TEX_SIZE:
+            self.error(
+                arg.pos,
+                f"a floating size (~w) is not allowed as the {pname} of '{op.name}'",
+                "floating sizes go in split sizes, setupProjection() and tileUV()",
+            )
+            return
+        if isinstance(arg, n.Relative) and kind not in (SIZE, TEX_SIZE):
             self.error(
                 arg.pos,
                 f"a relative size ('f) is not allowed as the {pname} of '{op.name}'",
-                "relative sizes go in s(), t() and split sizes",
+                "relative sizes go in s(), t(), split sizes, setupProjection() and tileUV()",
             )
             return
         self.arg(arg, local, relative_ok=True)
         expr = arg.expr if isinstance(arg, n.Relative) else arg
-        if kind in (NUMBER, SIZE) and isinstance(expr, (n.String, n.Bool)):
+        if op.name in _TEXTURE_OPS and isinstance(expr, n.String):
+            self.texture_file(expr)
+        if kind in (NUMBER, SIZE, TEX_SIZE) and isinstance(expr, (n.String, n.Bool)):
             self.error(expr.pos, f"the {pname} of '{op.name}' must be a number")
         elif kind == STRING and isinstance(expr, (n.Number, n.Bool)):
             self.error(
@@ -513,6 +534,16 @@ class Checker:
                     'a single colour argument is a "#rrggbb" string',
                     "or give three numbers: color(r, g, b)",
                 )
+
+    def texture_file(self, expr: n.String) -> None:
+        """A literal texture path must name a readable PNG or JPEG within the grammar's roots
+        (a computed one is checked when the derivation first uses it)."""
+        if not self.g.roots:  # a Grammar made by hand: its files are not checked
+            return
+        try:
+            load(self.g.path, self.g.roots, expr.value)
+        except TextureError as e:
+            self.error(expr.pos, e.message, e.hint)
 
     def allowed_symbols(self, kind: str) -> str:
         if kind == AXES:

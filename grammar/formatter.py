@@ -102,7 +102,7 @@ def format_expr(e) -> str:
     if isinstance(e, n.Call):
         return f"{e.name}({', '.join(format_arg(a) for a in e.args)})"
     if isinstance(e, n.Relative):
-        return "'" + format_expr(e.expr)
+        return ("~" if e.floating else "'") + format_expr(e.expr)
     if isinstance(e, n.Unary):
         inner = format_expr(e.operand)
         # `not` takes everything down to comparisons; `-` and `+` take only `**`

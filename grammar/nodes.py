@@ -92,10 +92,13 @@ class Ternary:
 
 @dataclass
 class Relative:
-    """``'expr`` as an operation argument: a fraction of the scope size (``s('0.5, 0, 0)``)."""
+    """``'expr`` as an operation argument: a fraction of the scope size (``s('0.5, 0, 0)``);
+    ``floating``: ``~expr``, a size rounded so that whole tiles span the scope
+    (``setupProjection(0, scope.xy, ~1.5, 1)``)."""
 
     expr: Expr
     pos: Pos = _pos()
+    floating: bool = False
 
 
 @dataclass

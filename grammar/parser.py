@@ -318,6 +318,9 @@ class _TreeBuilder(Transformer):
     def rel_arg(self, c):
         return n.Relative(c[1], pos=_span(c))
 
+    def float_arg(self, c):
+        return n.Relative(c[1], pos=_span(c), floating=True)
+
     def keyword_arg(self, c):
         return n.Keyword(str(c[0]), c[1], pos=_tok_pos(c[0]))
 
@@ -670,8 +673,8 @@ def _hint(tok: Token | None, expected: set[str]) -> str | None:
         return "a bracket is not closed"
     if tok.type in ("QUOTE", "TILDE"):
         return (
-            "relative sizes ('0.5) go in s(), t() and split blocks; "
-            "floating sizes (~2) in split blocks"
+            "relative sizes ('0.5) go in s(), t(), split blocks and texture sizes; "
+            "floating sizes (~2) in split blocks and texture sizes"
         )
     if tok.type == "COLON" and "PERCENT" in expected:
         return "a stochastic choice is written '60%: A'"

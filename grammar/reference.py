@@ -31,7 +31,7 @@ def reference_markdown() -> str:
         "Generated from `grammar/registry.py` by `python -m bgr.grammar.reference`; do not edit.",
         "",
     ]
-    families = ["transforms", "splits", "components", "roofs", "inserts", "appearance"]
+    families = ["transforms", "splits", "components", "roofs", "inserts", "appearance", "texturing"]
     for family in families:
         out += [
             f"## {family.capitalize()}",

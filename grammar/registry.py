@@ -23,6 +23,10 @@ ROOF_KIND = "roof kind"  # flat | gable | ...
 FOOTPRINT_KIND = "footprint kind"  # rect | L | U | T | cross | circle
 EXTRUDE_KIND = "extrusion direction"  # face.normal | world.up
 GEOMETRY = "geometry"  # a primitive or a declared asset
+TEX_SIZE = "texture size"  # numeric expression, 'f (a fraction of the scope) or ~w (floating)
+PROJECTION_AXES = "projection axes"  # scope.xy, world.xz ... (setupProjection)
+NORMALIZE_MODE = "normalize mode"  # uv | uvUniform | u | v
+NORMALIZE_TYPE = "normalize type"  # separatePerFace | collectiveAllFaces
 
 AXIS_NAMES = ("x", "y", "z")
 COMP_KINDS = ("f",)
@@ -44,6 +48,12 @@ COMP_SELECTORS = (
     "all",
 )
 OFFSET_SELECTORS = ("inside", "border")
+PROJECTION_AXES_NAMES = tuple(
+    f"{frame}.{a}{b}" for frame in ("scope", "world") for a in "xyz" for b in "xyz" if a != b
+)
+NORMALIZE_MODES = ("uv", "uvUniform", "u", "v")
+NORMALIZE_TYPES = ("separatePerFace", "collectiveAllFaces")
+UV_SETS = 10  # uv-sets 0..9, as CGA's texture layers (material.colormap is 0, normalmap 5)
 
 REQUIRED = object()
 
@@ -58,7 +68,7 @@ class Param:
 @dataclass(frozen=True)
 class Op:
     name: str
-    family: str  # transforms | splits | components | roofs | inserts | appearance
+    family: str  # transforms | splits | components | roofs | inserts | appearance | texturing
     signatures: tuple[tuple[Param, ...], ...]
     doc: str
     example: str
@@ -241,6 +251,99 @@ OPERATIONS: dict[str, Op] = {
             _sig(Param("name", STRING)),
             "Set the semantic label written to outputs (default: the terminal rule's name).",
             'label("Window")',
+        ),
+        # -- texturing (CGA's texturing operations; docs/language.md "Textures") -------------
+        Op(
+            "setupProjection",
+            "texturing",
+            _sig(
+                Param("uvSet", NUMBER),
+                Param("axes", PROJECTION_AXES),
+                Param("w", TEX_SIZE),
+                Param("h", TEX_SIZE),
+                Param("uOffset", NUMBER, 0.0),
+                Param("vOffset", NUMBER, 0.0),
+                Param("uwFactor", NUMBER, 0.0),
+            ),
+            "Set up the texture projection of uv-set 0..9 on the scope (`scope.xy`, `scope.xz`, "
+            "...) or the world (`world.xy`, ...) axes: a tile `w` by `h` metres (`~w` about w so "
+            "that whole tiles span the scope, `'f` a fraction of it, negative mirrors), offsets "
+            "in metres, `uwFactor` how much the third axis adds to u. The projection stays where "
+            "it was set up: split pieces, faces and moved shapes keep it, so tiles line up across "
+            "every cut.",
+            "setupProjection(0, scope.xy, ~1.5, 1)",
+        ),
+        Op(
+            "projectUV",
+            "texturing",
+            _sig(Param("uvSet", NUMBER)),
+            "Give the shape the texture coordinates of uv-set `uvSet` from its projection.",
+            "projectUV(0)",
+        ),
+        Op(
+            "texture",
+            "texturing",
+            _sig(Param("path", STRING)),
+            "Set the colour map (uv-set 0): a PNG or JPEG file, found like assets (the grammar's "
+            "folder, the stdlib, --allow-path); its alpha channel is the opacity.",
+            'texture("bricks.png")',
+        ),
+        Op(
+            "normalMap",
+            "texturing",
+            _sig(Param("path", STRING)),
+            "Set the normal map (CGA's material.normalmap, uv-set 5): a PNG or JPEG file, found "
+            "like texture().",
+            'normalMap("bricks_normal.png")',
+        ),
+        Op(
+            "tileUV",
+            "texturing",
+            _sig(Param("uvSet", NUMBER), Param("w", TEX_SIZE), Param("h", TEX_SIZE)),
+            "Rescale the texture coordinates so that one tile is `w` by `h` metres (`~w`, `'f` "
+            "and negative as in setupProjection; 0 leaves that direction as it is).",
+            "tileUV(0, ~2, '0.5)",
+        ),
+        Op(
+            "scaleUV",
+            "texturing",
+            _sig(Param("uvSet", NUMBER), Param("u", NUMBER), Param("v", NUMBER)),
+            "Multiply the texture coordinates by `u` and `v`.",
+            "scaleUV(0, 2, 2)",
+        ),
+        Op(
+            "translateUV",
+            "texturing",
+            _sig(Param("uvSet", NUMBER), Param("u", NUMBER), Param("v", NUMBER)),
+            "Add `u` and `v` to the texture coordinates (0.5 moves the texture half a tile).",
+            "translateUV(0, 0.5, 0)",
+        ),
+        Op(
+            "rotateUV",
+            "texturing",
+            _sig(Param("uvSet", NUMBER), Param("angle", NUMBER)),
+            "Rotate the texture coordinates about u = v = 0 by `angle` degrees "
+            "(counter-clockwise).",
+            "rotateUV(0, 90)",
+        ),
+        Op(
+            "normalizeUV",
+            "texturing",
+            _sig(
+                Param("uvSet", NUMBER),
+                Param("mode", NORMALIZE_MODE),
+                Param("type", NORMALIZE_TYPE, "collectiveAllFaces"),
+            ),
+            "Map the texture coordinates of the shape's scope onto 0..1: `uv` both, `u` or `v` "
+            "one, `uvUniform` both by one factor.",
+            "normalizeUV(0, uv, collectiveAllFaces)",
+        ),
+        Op(
+            "deleteUV",
+            "texturing",
+            _sig(Param("uvSet", NUMBER)),
+            "Remove the texture coordinates of uv-set `uvSet` (its projection stays).",
+            "deleteUV(0)",
         ),
     ]
 }

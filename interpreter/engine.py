@@ -22,7 +22,10 @@ from bgr.grammar.registry import (
     EXTRUDE_KIND,
     FOOTPRINT_KIND,
     GEOMETRY,
+    NORMALIZE_MODE,
+    NORMALIZE_TYPE,
     OPERATIONS,
+    PROJECTION_AXES,
     ROOF_KIND,
 )
 
@@ -41,11 +44,26 @@ from .limits import (
     memory_in_use,
 )
 from .operations import IMPLEMENTATIONS
+from .operations.texturing import follow
 from .randomness import Stream, child_hash, name_hash, root_hash
 from .shapes import Flat, Shape, Solid
 from .terminals import TerminalTable, UnitMesh
 
-SYMBOL_KINDS = {AXIS, AXES, COMP_KIND, ROOF_KIND, FOOTPRINT_KIND, EXTRUDE_KIND, GEOMETRY}
+SYMBOL_KINDS = {
+    AXIS,
+    AXES,
+    COMP_KIND,
+    ROOF_KIND,
+    FOOTPRINT_KIND,
+    EXTRUDE_KIND,
+    GEOMETRY,
+    PROJECTION_AXES,
+    NORMALIZE_MODE,
+    NORMALIZE_TYPE,
+}
+# operations that move or stretch a shape's geometry with its scope: its texture projections and
+# coordinates follow (texturing.follow).  reverseNormals keeps the outline where it is.
+_MOVERS = frozenset({"t", "r", "s", "center", "matrix"})
 _NUMBER = (float, int)  # bool is neither: True.__class__ is bool
 EMIT = object()  # marks a children-list entry that is a finished terminal, kept in order
 _NAME_HASHES: dict[str, int] = {}
@@ -280,6 +298,8 @@ class Engine:
         t.size.append(shape.size)
         t.color.append(shape.color)
         t.material.append(shape.material)
+        if shape.tex is not None:
+            t.add_texturing(len(t.label) - 1, shape.tex)
         mesh = self.mesh_id(shape.geom)
         t.mesh.append(mesh)
         counts = self._mesh_triangles
@@ -429,8 +449,15 @@ class Application:
         for step in steps:
             self.ctx.shape = shape
             if isinstance(step, n.Operation):
+                moved = (
+                    (shape.origin[:], shape.axes, shape.size[:])
+                    if shape.tex is not None and step.name in _MOVERS
+                    else None
+                )
                 if IMPLEMENTATIONS[step.name](self, shape, step, self.arguments(step, received)):
                     consumed = True
+                if moved is not None:
+                    follow(shape, *moved)
                 if step.name in _SCOPE_CHANGERS:
                     self.engine.check_scope(self.module, step, shape)
             elif isinstance(step, n.Successor):
@@ -465,7 +492,7 @@ class Application:
             plan = self.engine.signatures[id(step)] = self.plan(step)
         ctx = self.ctx
         out = [
-            value if kind == 0 else fn(ctx) if kind == 1 else ("rel", fn(ctx))
+            value if kind == 0 else fn(ctx) if kind == 1 else (value, fn(ctx))
             for kind, value, fn in plan
         ]
         for i, value in enumerate(out):
@@ -502,7 +529,8 @@ class Application:
             if param.kind in SYMBOL_KINDS:
                 plan.append((0, arg.name, None))
             elif isinstance(arg, n.Relative):
-                plan.append((2, None, self.engine.compiled(self.compiler, arg.expr, self.local)))
+                tag = "float" if arg.floating else "rel"
+                plan.append((2, tag, self.engine.compiled(self.compiler, arg.expr, self.local)))
             else:
                 plan.append((1, None, self.engine.compiled(self.compiler, arg, self.local)))
         return tuple(plan)

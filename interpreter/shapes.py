@@ -58,6 +58,7 @@ class Shape:
         "hash",
         "depth",
         "frame",
+        "tex",
     )
 
     def __init__(
@@ -84,6 +85,7 @@ class Shape:
         self.hash = hash_
         self.depth = depth
         self.frame = None  # (origin, axes) of the shape this one was cut from; None: the world
+        self.tex = None  # texturing.Texturing (projections, coordinates, maps), None: plain
 
     def copy(self) -> Shape:
         # slot by slot, not through __init__: a derivation copies shapes millions of times
@@ -99,6 +101,7 @@ class Shape:
         twin.hash = self.hash
         twin.depth = self.depth
         twin.frame = self.frame
+        twin.tex = self.tex  # immutable: shared until an operation replaces it
         return twin
 
     def cut_from(self, parent: Shape) -> Shape:

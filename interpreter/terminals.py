@@ -71,6 +71,16 @@ class TerminalTable:
     # [easting, northing, height]}: local x is easting - origin, local -z northing - origin
     site: dict | None = None
     grammar: str = ""  # the grammar's file (or "<string>"): the glTF root's extras name it
+    # textures (operations/texturing.py): each distinct image file once (grammar.textures.Image)
+    images: list = field(default_factory=list)
+    # the rows that carry a texture map, in order; frozen: (K,) int64
+    tex_rows: Any = field(default_factory=list)
+    # their (colour map, normal map) image indices, -1 for none; frozen: (K, 2) int32
+    tex_maps: Any = field(default_factory=list)
+    # their texture coordinates for the colour map (uv-set 0) and the normal map (uv-set 5, or 0
+    # when 5 has none) as affine maps: while deriving from WORLD points (16 floats a row), frozen
+    # from UNIT scope coordinates, (K, 2, 2, 4): uv = M[:, :3] @ v + M[:, 3] for a unit vertex v
+    tex_uv: Any = field(default_factory=list)
     frozen: bool = False
 
     def __len__(self) -> int:
@@ -83,8 +93,39 @@ class TerminalTable:
             self.size = np.asarray(self.size, dtype=np.float64).reshape(-1, 3)
             self.color = np.asarray(self.color, dtype=np.float64).reshape(-1, 3)
             self.mesh = np.asarray(self.mesh, dtype=np.int32).reshape(-1)
+            self.tex_rows = np.asarray(self.tex_rows, dtype=np.int64).reshape(-1)
+            self.tex_maps = np.asarray(self.tex_maps, dtype=np.int32).reshape(-1, 2)
+            self.tex_uv = unit_maps(
+                np.asarray(self.tex_uv, dtype=np.float64).reshape(-1, 2, 2, 4),
+                self.origin[self.tex_rows],
+                self.axes[self.tex_rows],
+                self.size[self.tex_rows],
+            )
             self.frozen = True
         return self
+
+    def add_image(self, image) -> int:
+        """The index of a texture image, each distinct file (resolved path) stored once."""
+        for k, known in enumerate(self.images):
+            if known.path == image.path:
+                return k
+        self.images.append(image)
+        return len(self.images) - 1
+
+    def add_texturing(self, row: int, tex) -> None:
+        """Record the texture maps and coordinates of terminal ``row`` (a shape's
+        ``texturing.Texturing``); a shape without a texture map writes nothing here."""
+        if tex.color < 0 and tex.normal < 0:
+            return
+        none = (0.0,) * 8
+        color = tex.uv[0] or none
+        normal = tex.uv[5] or tex.uv[0] or none
+        self.tex_rows.append(row)
+        self.tex_maps.append((tex.color, tex.normal))
+        self.tex_uv.append((*color, *normal))
+
+    def textured(self) -> bool:
+        return len(self.tex_rows) > 0
 
     def geometry_names(self) -> list[str]:
         names = [m.name for m in self.library.meshes]
@@ -104,6 +145,24 @@ def world_vertices(table: TerminalTable, rows: np.ndarray, mesh: UnitMesh) -> np
     """(len(rows), V, 3) world positions of one unit mesh placed at the given terminals."""
     local = mesh.vertices[None, :, :] * table.size[rows][:, None, :]
     return table.origin[rows][:, None, :] + np.einsum("nvk,nkj->nvj", local, table.axes[rows])
+
+
+def unit_maps(world: np.ndarray, origin: np.ndarray, axes: np.ndarray, size: np.ndarray):
+    """Texture maps from world points (K, S, 2, 4) made maps from unit scope coordinates of the
+    K terminals: world x = origin + (v * size) @ axes, so uv = (L @ axes.T * size) v + L o + m."""
+    lin = world[..., :3]
+    out = np.empty_like(world)
+    out[..., :3] = np.einsum("ksij,klj->ksil", lin, axes) * size[:, None, None, :]
+    out[..., 3] = np.einsum("ksij,kj->ksi", lin, origin) + world[..., 3]
+    return out
+
+
+def texture_part(table: TerminalTable, part: TerminalTable, first: int, end: int) -> None:
+    """Give ``part`` (rows first..end of a frozen ``table``) their texturing, rows from 0."""
+    part.images = table.images
+    keep = (table.tex_rows >= first) & (table.tex_rows < end)
+    part.tex_rows = table.tex_rows[keep] - first
+    part.tex_maps, part.tex_uv = table.tex_maps[keep], table.tex_uv[keep]
 
 
 def lot_tables(table: TerminalTable) -> list[TerminalTable]:
@@ -131,6 +190,7 @@ def lot_tables(table: TerminalTable) -> list[TerminalTable]:
         for mesh_id in used:
             part.library.meshes.append(table.library.meshes[int(mesh_id)])
         part.lots = [{**lot, "rows": [0, end - first]}]
+        texture_part(table, part, first, end)
         part.frozen = True
         parts.append(part)
     return parts
@@ -165,5 +225,20 @@ def concat(
     out.origin, out.axes = stacked("origin", (0, 3)), stacked("axes", (0, 3, 3))
     out.size, out.color = stacked("size", (0, 3)), stacked("color", (0, 3))
     out.mesh = np.concatenate(meshes).astype(np.int32) if meshes else np.zeros(0, np.int32)
+    rows, maps, uvs = (
+        [np.zeros(0, np.int64)],
+        [np.zeros((0, 2), np.int32)],
+        [np.zeros((0, 2, 2, 4))],
+    )
+    at = 0
+    for part in parts:
+        if part.textured():  # image numbers of the part -> of the whole, each file once
+            remap = np.array([out.add_image(im) for im in part.images] + [-1], dtype=np.int32)
+            rows.append(part.tex_rows + at)
+            maps.append(remap[part.tex_maps])  # -1 stays -1: the appended last entry
+            uvs.append(part.tex_uv)
+        at += len(part)
+    out.tex_rows, out.tex_maps = np.concatenate(rows), np.concatenate(maps).astype(np.int32)
+    out.tex_uv = np.concatenate(uvs)
     out.frozen = True
     return out

@@ -471,8 +471,25 @@ CASES = [
         1,
         15,
         "a relative size ('f) is not allowed as the height of 'extrude'",
-        "relative sizes go in s(), t() and split sizes",
+        "relative sizes go in s(), t(), split sizes, setupProjection() and tileUV()",
         id="relative-size-in-extrude",
+    ),
+    # ~w parses as an argument since textures (issue 26); only texture sizes take it
+    pytest.param(
+        "A --> extrude(~2)\n",
+        1,
+        15,
+        "a floating size (~w) is not allowed as the height of 'extrude'",
+        "floating sizes go in split sizes, setupProjection() and tileUV()",
+        id="floating-size-in-extrude",
+    ),
+    pytest.param(
+        "A --> t(~1, 0, 0)\n",
+        1,
+        9,
+        "a floating size (~w) is not allowed as the x of 't'",
+        "floating sizes go in split sizes, setupProjection() and tileUV()",
+        id="floating-size-in-t",
     ),
     pytest.param(
         "A --> B('0.5)\nB(x) --> NIL\n",

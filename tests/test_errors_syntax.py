@@ -283,10 +283,6 @@ CASES = [
     ),
     # ---- relative and floating sizes outside split blocks -----------------------------------
     pytest.param(
-        "A --> extrude(~2)\n", 1, 15, "unexpected '~'", None, id="floating-size-in-extrude"
-    ),
-    pytest.param("A --> t(~1, 0, 0)\n", 1, 9, "unexpected '~'", None, id="floating-size-in-t"),
-    pytest.param(
         "attr h = '0.5\nA --> NIL\n", 1, 10, "unexpected", "relative", id="relative-size-in-attr"
     ),
     # ---- blocks -----------------------------------------------------------------------------

@@ -6,7 +6,7 @@ application (for evaluating, spawning pieces and reporting errors), ``shape`` th
 scope ``center()`` aligns to.  It returns True when the shape is used up (split, comp, roof...).
 """
 
-from . import appearance, components, inserts, roofs, splits, transforms
+from . import appearance, components, inserts, roofs, splits, texturing, transforms
 
 IMPLEMENTATIONS = {
     "t": transforms.translate,
@@ -26,4 +26,14 @@ IMPLEMENTATIONS = {
     "color": appearance.color,
     "material": appearance.material,
     "label": appearance.label,
+    "setupProjection": texturing.setup_projection,
+    "projectUV": texturing.project_uv,
+    "texture": texturing.texture,
+    "normalMap": texturing.normal_map,
+    "tileUV": texturing.tile_uv,
+    "scaleUV": texturing.scale_uv,
+    "translateUV": texturing.translate_uv,
+    "rotateUV": texturing.rotate_uv,
+    "normalizeUV": texturing.normalize_uv,
+    "deleteUV": texturing.delete_uv,
 }
