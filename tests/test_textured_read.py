@@ -254,3 +254,63 @@ def test_missing_image_is_a_warning(tmp_path):
     mesh = read_citygml(_write(tmp_path, image="tex/absent.png"))
     assert not mesh.textured().any()
     assert "absent.png' is missing" in mesh.warnings[0].message and mesh.warnings[0].line == 25
+
+
+# --------------------------------------------------------------------------------------------
+# glTF / GLB
+
+
+def _quad_glb(tmp_path, name: str = "quad.glb"):
+    """A unit quad in the xy plane whose UVs are its x and y, textured with the 4x2 image."""
+    import trimesh
+
+    _write(tmp_path)  # makes tex/wall.png
+    image = Image.open(tmp_path / "tex" / "wall.png")
+    verts = np.array([[0.0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0]])
+    mesh = trimesh.Trimesh(
+        verts,
+        [[0, 1, 2], [0, 2, 3]],
+        visual=trimesh.visual.TextureVisuals(uv=verts[:, :2], image=image),
+        process=False,
+    )
+    path = tmp_path / name
+    path.write_bytes(trimesh.Scene(mesh).export(file_type="glb"))
+    return path
+
+
+def test_glb_texture_and_uvs(tmp_path):
+    from bgr.formats.gltf_textured import read_gltf_textured
+
+    mesh = read_gltf_textured(_quad_glb(tmp_path))
+    assert mesh.up == "y" and len(mesh.faces) == 2 and mesh.textured().all()
+    corners = mesh.vertices[mesh.faces]
+    # v runs up the image, as in CityGML and OBJ: the file's flipped v is flipped back
+    np.testing.assert_allclose(mesh.uv, corners[..., :2], atol=1e-6)
+    texture = mesh.materials[0]
+    assert texture.image is None and texture.data is not None  # the GLB's own bufferView
+    assert texture.image_size() == (4, 2)
+    col, row = pixels(np.array([0.75, 0.5]), texture.image_size(), texture.wrap)
+    assert tuple(
+        np.asarray(Image.open(__import__("io").BytesIO(texture.image_bytes())))[row, col][:3]
+    ) == (0, 0, 255)
+
+
+def test_gltf_image_outside_its_folder_is_refused_and_a_missing_one_warned(tmp_path):
+    import json
+
+    import trimesh
+
+    from bgr.formats.gltf_textured import read_gltf_textured
+
+    files = trimesh.load(_quad_glb(tmp_path)).export(file_type="gltf", embed_buffers=True)
+    gltf = json.loads(files["model.gltf"])
+    gltf["images"] = [{"uri": "../outside.png"}]
+    path = tmp_path / "quad.gltf"
+    path.write_text(json.dumps(gltf))
+    with pytest.raises(BgrError, match="outside the model's folder") as info:
+        read_gltf_textured(path)
+    assert info.value.path == str(path)
+    gltf["images"] = [{"uri": "absent.png"}]
+    path.write_text(json.dumps(gltf))
+    mesh = read_gltf_textured(path)
+    assert not mesh.textured().any() and "absent.png' is missing" in mesh.warnings[0].message
