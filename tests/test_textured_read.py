@@ -314,3 +314,88 @@ def test_gltf_image_outside_its_folder_is_refused_and_a_missing_one_warned(tmp_p
     path.write_text(json.dumps(gltf))
     mesh = read_gltf_textured(path)
     assert not mesh.textured().any() and "absent.png' is missing" in mesh.warnings[0].message
+
+
+# --------------------------------------------------------------------------------------------
+# OBJ + MTL
+
+# two triangles sharing the edge 1-3, each with its own vt at the shared corners (per corner)
+OBJ = """mtllib wall.mtl
+v 0 0 0
+v 2 0 0
+v 2 1 0
+v 0 1 0
+vt 0 0
+vt 1 0
+vt 1 1
+vt 0 1
+vt 0.5 0.5
+o quad
+usemtl brick
+f 1/1 2/2 3/3
+usemtl plain
+f 1/5 3/5 4/4
+"""
+MTL = """newmtl brick
+Kd 1 1 1
+map_Kd -s 1 1 1 {image}
+newmtl plain
+Kd 0.5 0.25 0
+d 0.5
+"""
+
+
+def _obj(tmp_path, obj: str = OBJ, image: str = "tex/wall.png"):
+    _write(tmp_path)  # tex/wall.png
+    (tmp_path / "wall.mtl").write_text(MTL.format(image=image))
+    path = tmp_path / "wall.obj"
+    path.write_text(obj)
+    return path
+
+
+def test_obj_keeps_each_corners_texture_coordinates(tmp_path):
+    from bgr.formats.obj_textured import read_obj_textured
+
+    mesh = read_obj_textured(_obj(tmp_path))
+    assert mesh.faces.tolist() == [[0, 1, 2], [0, 2, 3]] and mesh.object_ids == ["quad"]
+    np.testing.assert_allclose(mesh.uv[0], [[0, 0], [1, 0], [1, 1]])
+    np.testing.assert_allclose(mesh.uv[1], [[0.5, 0.5], [0.5, 0.5], [0, 1]])
+    brick, plain = (mesh.materials[k] for k in mesh.material)
+    assert brick.image == (tmp_path / "tex" / "wall.png").resolve() and plain.image is None
+    assert plain.color == (0.5, 0.25, 0.0, 0.5)
+    assert mesh.textured().tolist() == [True, False]
+
+
+def test_obj_quads_are_fanned_and_negative_indices_count_back(tmp_path):
+    from bgr.formats.obj_textured import read_obj_textured
+
+    obj = "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nvt 0 0\nf -4/1 -3/1 -2/1 -1/1\n"
+    mesh = read_obj_textured(_obj(tmp_path, obj))
+    assert mesh.faces.tolist() == [[0, 1, 2], [0, 2, 3]] and (mesh.material == -1).all()
+
+
+@pytest.mark.parametrize(
+    ("obj", "message", "line"),
+    [
+        ("v 0 0 0\nf 1 2 3\n", "vertex 2 does not exist", 2),
+        ("v 0 0 0\nv 1 0 0\nv 0 nan 0\nf 1 2 3\n", "not finite", 3),
+        ("v 0 0 0\nv 1 0 0\nv 0 x 0\nf 1 2 3\n", "is not 3 numbers", 3),
+        ("mtllib ../x.mtl\nv 0 0 0\n", "outside the model's folder", 1),
+    ],
+)
+def test_obj_bad_input_is_located(tmp_path, obj, message, line):
+    from bgr.formats.obj_textured import read_obj_textured
+
+    with pytest.raises(BgrError, match=message) as info:
+        read_obj_textured(_obj(tmp_path, obj))
+    assert info.value.line == line
+
+
+def test_obj_image_outside_is_refused_and_a_missing_one_warned(tmp_path):
+    from bgr.formats.obj_textured import read_obj_textured
+
+    with pytest.raises(BgrError, match="outside the model's folder") as info:
+        read_obj_textured(_obj(tmp_path, image="../../etc/passwd"))
+    assert info.value.path.endswith("wall.mtl") and info.value.line == 3
+    mesh = read_obj_textured(_obj(tmp_path, image="tex/absent.png"))
+    assert not mesh.textured().any() and "is missing" in mesh.warnings[0].message
