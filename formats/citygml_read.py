@@ -55,10 +55,16 @@ def read_citygml(
         raise BgrError(Diagnostic(shown, 0, 0, "no such CityGML file")) from None
     except OSError as exc:
         raise BgrError(Diagnostic(shown, 0, 0, f"cannot read the CityGML file: {exc}")) from None
-    raw = parse_citygml(data, shown)
-    polygons = _levels(raw.polygons, lod, shown)
-    materials, sources, of_target = _appearances(raw, theme, resolved(path).parent, shown)
-    mesh = _mesh(polygons, materials, sources, of_target, raw, shown)
+    try:
+        raw = parse_citygml(data, shown)
+        polygons = _levels(raw.polygons, lod, shown)
+        materials, sources, of_target = _appearances(raw, theme, resolved(path).parent, shown)
+        mesh = _mesh(polygons, materials, sources, of_target, raw, shown)
+    except (ValueError, TypeError, IndexError, KeyError, OverflowError, RecursionError) as exc:
+        # the reader turns what it expects into located messages; this is what it did not
+        raise BgrError(
+            Diagnostic(shown, 0, 0, f"cannot read the CityGML file: {str(exc)[:200]}")
+        ) from None
     mesh.crs, mesh.source = raw.crs, shown
     return mesh
 

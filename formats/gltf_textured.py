@@ -14,6 +14,7 @@ Vertices are placed in world space and stay y up (``up = "y"``), as glTF has the
 from __future__ import annotations
 
 import base64
+import struct
 from pathlib import Path
 
 import numpy as np
@@ -57,6 +58,10 @@ def read_gltf_textured(path: str | Path) -> TexturedMesh:
     except BgrError as exc:
         raise BgrError(
             Diagnostic(shown, 0, 0, f"not a glTF file bgr can read: {exc.message}", exc.hint)
+        ) from None
+    except (ValueError, TypeError, IndexError, KeyError, AttributeError, struct.error) as exc:
+        raise BgrError(
+            Diagnostic(shown, 0, 0, f"not a glTF file bgr can read: {str(exc)[:200]}")
         ) from None
     mesh.source = shown
     return mesh

@@ -399,3 +399,20 @@ def test_obj_image_outside_is_refused_and_a_missing_one_warned(tmp_path):
     assert info.value.path.endswith("wall.mtl") and info.value.line == 3
     mesh = read_obj_textured(_obj(tmp_path, image="tex/absent.png"))
     assert not mesh.textured().any() and "is missing" in mesh.warnings[0].message
+
+
+def test_uvs_far_outside_the_image_are_kept_and_wrap_into_it(tmp_path):
+    text = _wall_with("0 0 1 0 1 1 0 1 0 0", "-2 0 1 0 1 7.5 -2 7.5 -2 0").replace(
+        "</app:imageURI>", "</app:imageURI><app:wrapMode>wrap</app:wrapMode>"
+    )
+    mesh = read_citygml(_write(tmp_path, text=text))
+    wall = mesh.mask(semantic="WallSurface")
+    corners = mesh.vertices[mesh.faces[wall]]
+    np.testing.assert_allclose(mesh.uv[wall][..., 0], corners[..., 0] * 3 / 4 - 2)
+    np.testing.assert_allclose(mesh.uv[wall][..., 1], corners[..., 2] * 7.5 / 3)
+    texture = mesh.materials[mesh.material[wall][0]]
+    assert texture.wrap == "wrap"
+    px = pixels(mesh.uv[wall], texture.image_size(), texture.wrap)
+    assert (px >= 0).all() and (px < [4, 2]).all()
+    # u = -1.75 repeats to 0.25: the red half; u = 0.75 the blue half
+    assert pixels(np.array([[-1.75, 0.5], [0.75, 0.5]]), (4, 2), "wrap")[:, 0].tolist() == [1, 3]
