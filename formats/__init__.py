@@ -24,7 +24,8 @@ from bgr.interpreter.limits import MAX_COORDINATE
 from bgr.interpreter.terminals import TerminalTable
 
 from .atomic import atomic_files
-from .cityjson import read_cityjson, write_cityjson, write_cityjsonseq
+from .cityjson import write_cityjson, write_cityjsonseq
+from .cityjson_read import read_cityjson
 from .glb import write_glb, write_gltf
 from .glb_read import read_glb
 from .meshes import bake, to_trimesh
