@@ -22,6 +22,9 @@ What the writer makes of a terminal table (docs/cli.md, "CityJSON", is the user'
   closed Solid: grammar output rarely is.
 - **Semantics** per triangle, from the terminal's label, else the triangle's normal: see
   :func:`semantic_of_label` and :func:`semantic_types`.
+- **Appearance** (``.city.json``): the colours as materials and the colour maps as textures
+  (:mod:`.cityjson_appearance`; the images copied beside the file).  A sequence
+  (``.city.jsonl``) has neither: its features are written before the run is over.
 """
 
 from __future__ import annotations
@@ -37,10 +40,12 @@ import numpy as np
 from bgr.grammar.errors import BgrError
 from bgr.interpreter.terminals import TerminalTable, lot_tables
 
+from .cityjson_appearance import Appearance
 from .cityjson_read import CityModel as CityModel  # the reader, where it used to be
 from .cityjson_read import CityObjectMesh as CityObjectMesh
 from .cityjson_read import read_cityjson as read_cityjson
 from .meshes import bake, cross, unit_normals
+from .texture_files import Copies
 
 VERSION = "2.0"
 SCALE = 0.001  # metres per integer unit: a millimetre grid
@@ -149,6 +154,7 @@ class Triangles:
     mm: np.ndarray  # (T, 3, 3) int64: corners on the local millimetre grid
     row: np.ndarray  # (T,) the terminal each came from
     kind: np.ndarray  # (T,) semantic type, an index into SEMANTIC_TYPES
+    face: np.ndarray  # (T,) its index among the baked triangles (meshes.bake): its uvs
 
 
 def to_cityjson_axes(points: np.ndarray) -> np.ndarray:
@@ -172,6 +178,7 @@ def triangles(table: TerminalTable, lots: list[dict]) -> Triangles:
     # fewer than three distinct grid points, or three in a line: no area
     twice_area = cross((mm[:, 1] - mm[:, 0]).astype(float), (mm[:, 2] - mm[:, 0]).astype(float))
     keep = np.abs(twice_area).max(axis=1) > 0
+    face = np.flatnonzero(keep)
     mm, row, corners = mm[keep], row[keep], corners[keep]
     lot_of_row = np.repeat(
         np.arange(len(lots), dtype=np.int64), [end - first for first, end in _ranges(lots)]
@@ -181,7 +188,7 @@ def triangles(table: TerminalTable, lots: list[dict]) -> Triangles:
     np.minimum.at(base, lot, corners[:, :, 2].min(axis=1))
     normal_z = unit_normals(corners)[:, 2]
     kind = semantic_types(table.label, row, normal_z, corners[:, :, 2].max(axis=1), base[lot])
-    return Triangles(mm, row, kind)
+    return Triangles(mm, row, kind, face)
 
 
 # --------------------------------------------------------------------------------------------
@@ -379,9 +386,12 @@ def _dumps(value: Any) -> str:
     return json.dumps(value, ensure_ascii=False, allow_nan=False, separators=(",", ":"))
 
 
-def _objects(objs: list[CityObjectPlan], tris: Triangles, grid: Grid) -> tuple[str, np.ndarray]:
+def _objects(
+    objs: list[CityObjectPlan], tris: Triangles, grid: Grid, look: Appearance | None = None
+) -> tuple[str, np.ndarray]:
     """(the CityObjects member's JSON text, vertices) of some objects: the vertices their
-    triangles use, each once.  The large arrays are written as text directly."""
+    triangles use, each once.  The large arrays are written as text directly.  ``look``: the
+    surfaces' materials and textures (:mod:`.cityjson_appearance`)."""
     used = np.concatenate([o.triangles for o in objs]) if objs else np.zeros(0, np.int64)
     points = tris.mm[used].reshape(-1, 3) - grid.low
     low = points.min(axis=0) if len(points) else np.zeros(3, np.int64)
@@ -407,7 +417,9 @@ def _objects(objs: list[CityObjectPlan], tris: Triangles, grid: Grid) -> tuple[s
                 f'{{"type":"MultiSurface","lod":"{lod}",'
                 f'"boundaries":{_rows_text(index[at : at + n], "[[%d,%d,%d]]")},'
                 f'"semantics":{{"surfaces":{_dumps(semantics["surfaces"])},'
-                f'"values":{_rows_text(semantics["values"][:, None], "%d")}}}}}'
+                f'"values":{_rows_text(semantics["values"][:, None], "%d")}}}'
+                + (look.geometry_text(o.triangles) if look else "")
+                + "}"
             )
             text = text[:-1] + f',"geometry":[{geometry}]}}'
         at += n
@@ -439,11 +451,25 @@ def _prepare(table: TerminalTable, attrs: dict) -> tuple[Triangles, list, Grid, 
     return tris, plan(table, tris, lots), grid, _dumps(head)[:-1]
 
 
-def write_cityjson(table: TerminalTable, stream: BinaryIO, *, seed: int, attrs: dict) -> None:
-    """The whole table as one CityJSON 2.0 document (the module's docstring says how)."""
+def write_cityjson(
+    table: TerminalTable,
+    stream: BinaryIO,
+    *,
+    seed: int,
+    attrs: dict,
+    textures: Copies | None = None,
+) -> None:
+    """The whole table as one CityJSON 2.0 document (the module's docstring says how), with
+    its ``appearance``: the colours as materials, and the colour maps as textures where
+    ``textures`` names the images' copies (:func:`bgr.formats.write` makes them)."""
     tris, buildings, grid, head = _prepare(table, attrs)
-    objects, vertices = _objects([o for b in buildings for o in b], tris, grid)
-    text = f'{head},"CityObjects":{objects},"vertices":{_rows_text(vertices, "[%d,%d,%d]")}}}\n'
+    look = Appearance.of(table, tris.row, tris.face, textures) if len(tris.row) else None
+    objects, vertices = _objects([o for b in buildings for o in b], tris, grid, look)
+    text = (
+        f'{head},"CityObjects":{objects},"vertices":{_rows_text(vertices, "[%d,%d,%d]")}'
+        + (look.text() if look else "")
+        + "}\n"
+    )
     stream.write(text.encode("utf-8"))
 
 
