@@ -30,7 +30,7 @@ from .materials import materials_of
 from .meshes import MeshPool, face_offsets
 from .sharing import number_rows
 from .texcoords import baked_uvs
-from .text import quantize
+from .text import decimal, quantize, render, word
 from .texture_files import Copies
 
 THEME = "bgr"
@@ -113,23 +113,39 @@ class Appearance:
         if len(mat) and (mat == mat[0]).all():
             text = f',"material":{{"{THEME}":{{"value":{int(mat[0])}}}}}'
         else:
-            text = f',"material":{{"{THEME}":{{"values":{_dumps(mat.tolist())}}}}}'
+            text = f',"material":{{"{THEME}":{{"values":{_ints(mat[:, None], "%d")}}}}}'
         tex = self.texture[triangles]
         if not (tex >= 0).any():
             return text
-        values = np.full(len(triangles), "[[null]]", dtype=object)
-        mine = tex >= 0
-        quads = np.column_stack([tex[mine], self.corners[triangles[mine]]])
-        values[mine] = ("[[%d,%d,%d,%d]]\n" * len(quads) % tuple(quads.ravel().tolist())).split(
-            "\n"
-        )[:-1]
-        return text + f',"texture":{{"{THEME}":{{"values":[{",".join(values.tolist())}]}}}}'
+        # printf in C for every surface, then an untextured one's -1s become [[null]]
+        rows = np.column_stack([tex, self.corners[triangles]])
+        values = _ints(rows, "[[%d,%d,%d,%d]]").replace("[[-1,-1,-1,-1]]", "[[null]]")
+        return text + f',"texture":{{"{THEME}":{{"values":{values}}}}}'
 
     def text(self) -> str:
         """The ``appearance`` member's text (starting with a comma); its vertices-texture
-        written from the quantized integers, six decimals."""
+        written in bulk from the quantized integers, six decimals (:mod:`.text`)."""
         body = _dumps(self.member)
         if "textures" not in self.member:
             return f',"appearance":{body}'
-        numbers = _dumps((self.uv / 1e6).tolist())
-        return f',"appearance":{body[:-1]},"vertices-texture":{numbers}}}'
+        return f',"appearance":{body[:-1]},"vertices-texture":{_pairs(self.uv)}}}'
+
+
+def _ints(rows: np.ndarray, pattern: str) -> str:
+    """A JSON array of integer rows, each written by ``pattern``: printf formatting in C."""
+    if not len(rows):
+        return "[]"
+    return "[" + ((pattern + ",") * len(rows) % tuple(rows.ravel().tolist()))[:-1] + "]"
+
+
+def _pairs(q: np.ndarray) -> str:
+    """``[[u,v],...]`` of (n, 2) quantized numbers (:func:`.text.quantize`), as the OBJ writer
+    formats its ``vt``: a grid of words, no Python call per number."""
+    if not len(q):
+        return "[]"
+    (wu, fu), (wv, fv) = decimal(q[:, 0], b"["), decimal(q[:, 1], b",")
+    grid = np.empty((len(q), wu.shape[1] + wv.shape[1] + 3), dtype=np.uint64)
+    a, b = wu.shape[1], wu.shape[1] + 1 + wv.shape[1]
+    grid[:, :a], grid[:, a], grid[:, a + 1 : b], grid[:, b] = wu, fu, wv, fv
+    grid[:, -1] = word(b"],")
+    return "[" + render(grid)[:-1].decode("ascii") + "]"

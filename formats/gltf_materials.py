@@ -20,7 +20,7 @@ from bgr.interpreter.terminals import TerminalTable
 
 from .materials import Materials, materials_of
 from .meshes import MeshPool, face_offsets
-from .texcoords import corner_uvs, texture_keys
+from .texcoords import corner_uvs
 
 LINEAR, REPEAT = 9729, 10497
 
@@ -52,17 +52,32 @@ class MaterialIndex:
             number[k] = self.numbers[key]
         local.index = number[local.index] if len(local.index) else local.index
         if len(table.tex_rows):  # a textured terminal's material also names its images
-            keys = texture_keys(table)
-            for row in np.asarray(table.tex_rows).tolist():
-                k = int(local.index[row])
-                key = (self.names[k], *(int(c) for c in self.rgb8[k]), *keys[row])
-                if key not in self.numbers:
-                    self.numbers[key] = len(self.names)
-                    self.names.append(self.names[k])
-                    self.rgb8.append(self.rgb8[k])
-                    self.textures.append(keys[row])
-                local.index[row] = self.numbers[key]
+            self._textured(table, local)
         return local
+
+    def _textured(self, table: TerminalTable, local: Materials) -> None:
+        """Give the textured rows the materials of their (colour, name, colour map, normal
+        map), numbered in first-use order: a Python step per distinct combination, not per
+        row."""
+        rows = np.asarray(table.tex_rows, dtype=np.int64)
+        maps = np.asarray(table.tex_maps, dtype=np.int64).reshape(-1, 2) + 1  # 0: none
+        n_images = len(table.images) + 1
+        code = (local.index[rows] * n_images + maps[:, 0]) * n_images + maps[:, 1]
+        combos, first, inverse = np.unique(code, return_index=True, return_inverse=True)
+        number = np.empty(len(combos), dtype=np.int64)
+        paths = [None, *(image.path for image in table.images)]
+        for j in np.argsort(first, kind="stable").tolist():  # in order of first use
+            row = int(first[j])
+            k = int(local.index[rows[row]])
+            images = (paths[int(maps[row, 0])], paths[int(maps[row, 1])])
+            key = (self.names[k], *(int(c) for c in self.rgb8[k]), *images)
+            if key not in self.numbers:
+                self.numbers[key] = len(self.names)
+                self.names.append(self.names[k])
+                self.rgb8.append(self.rgb8[k])
+                self.textures.append(images)
+            number[j] = self.numbers[key]
+        local.index[rows] = number[inverse.reshape(-1)]
 
     def all(self) -> Materials:
         """Every material so far, with its display label (which needs all of them)."""

@@ -1,5 +1,5 @@
-"""Texture coordinates of baked terminals, in the order :func:`meshes.place_corners` writes
-their corners, and the glTF material keys of textured terminals.
+"""Texture coordinates of baked terminals, in the order :func:`meshes.place_corners` (glTF) or
+:func:`meshes.bake` (OBJ, CityJSON) gives their corners.
 
 A terminal's coordinates are an affine map of its unit-scope vertices (the terminal table's
 ``tex_uv``), so every corner's uv is one matrix product per unit mesh, numpy in bulk.  glTF puts
@@ -51,17 +51,6 @@ def cga_corner_uvs(
         at = (start[sel][:, None] + np.arange(F)).reshape(-1)
         out[at] = tri.reshape(-1, 3, 2)
     return out
-
-
-def texture_keys(table: TerminalTable) -> list[tuple[str | None, str | None]]:
-    """Per row, the (colour map, normal map) image paths; (None, None) for plain rows."""
-    keys: list[tuple[str | None, str | None]] = [(None, None)] * len(table)
-    images = table.images
-    for row, (c, nm) in zip(
-        np.asarray(table.tex_rows).tolist(), np.asarray(table.tex_maps).tolist(), strict=True
-    ):
-        keys[row] = (images[c].path if c >= 0 else None, images[nm].path if nm >= 0 else None)
-    return keys
 
 
 def baked_uvs(table: TerminalTable, rows: np.ndarray, pool: MeshPool) -> np.ndarray:
