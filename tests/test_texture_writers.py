@@ -342,6 +342,27 @@ def test_cityjson_appearance_is_valid_and_indexes_hand_computed_uvs(folder):
     assert got == {(0.0, 0.0), (2.0, 0.0), (2.0, 2.0), (0.0, 2.0)}
 
 
+def test_cjio_finds_the_materials_textures_and_their_folder(folder):
+    import subprocess
+    import sys
+
+    table = derive(folder, f"Facade --> {PROJECTED} Tile\n")
+    out = folder / "c.city.json"
+    write(table, out, seed=0, attrs={})
+    script = (
+        "import json, sys\nfrom cjio import cityjson\n"
+        "cm = cityjson.reader(open(sys.argv[1]))\ncm.check_version()\n"
+        "print(json.dumps([cm.get_info(), cm.get_textures_location()]))\n"
+    )
+    run = subprocess.run(
+        [sys.executable, "-c", script, str(out)], capture_output=True, text=True, check=False
+    )
+    assert run.returncode == 0, run.stderr
+    info, location = json.loads(run.stdout.splitlines()[-1])
+    assert "materials = True" in info and "textures = True" in info
+    assert Path(location) == folder / "c_textures"
+
+
 def test_untextured_cityjson_has_materials_but_no_textures(folder):
     table = derive(folder, "Facade --> color(1, 0, 0) Tile\n")
     out = folder / "p.city.json"
