@@ -363,6 +363,20 @@ def test_cjio_finds_the_materials_textures_and_their_folder(folder):
     assert Path(location) == folder / "c_textures"
 
 
+def test_a_jpeg_is_copied_as_given_and_typed_jpg(folder):
+    Image.new("RGB", (4, 4), (200, 100, 50)).save(folder / "photo.JPEG", format="JPEG")
+    table = derive(
+        folder,
+        'Facade --> setupProjection(0, scope.xy, 1, 1) projectUV(0) texture("photo.JPEG") Tile\n',
+    )
+    write(table, folder / "j.city.json", seed=0, attrs={})
+    doc = json.loads((folder / "j.city.json").read_text())
+    assert doc["appearance"]["textures"][0]["type"] == "JPG"
+    assert doc["appearance"]["textures"][0]["image"] == "j_textures/photo.jpeg"
+    copy = folder / "j_textures" / "photo.jpeg"
+    assert copy.read_bytes() == (folder / "photo.JPEG").read_bytes()
+
+
 def test_untextured_cityjson_has_materials_but_no_textures(folder):
     table = derive(folder, "Facade --> color(1, 0, 0) Tile\n")
     out = folder / "p.city.json"
