@@ -23,8 +23,8 @@ from bgr.grammar.errors import BgrError, Diagnostic
 from bgr.interpreter.limits import MAX_COORDINATE
 from bgr.interpreter.terminals import TerminalTable
 
-from .atomic import atomic_files
-from .cityjson import read_cityjson, write_cityjson, write_cityjsonseq
+from .cityjson import write_cityjson, write_cityjsonseq
+from .cityjson_read import read_cityjson
 from .glb import write_glb, write_gltf
 from .glb_read import read_glb
 from .meshes import bake, to_trimesh
@@ -32,6 +32,7 @@ from .obj import write_obj
 from .ply import write_ply
 from .stl import write_stl
 from .terminal_json import write_json, write_json_bytes
+from .texture_files import Copies, atomic_with_images, texture_folder
 
 # format name -> writer(table, binary stream, *, seed, attrs); obj is special (two files)
 # the writer of each format: (table, binary stream, seed=, attrs=) -> None
@@ -47,6 +48,7 @@ FORMATS: dict[str, Callable[..., None]] = {
 }
 EXTENSIONS = {f".{name}": name for name in FORMATS}
 GLTF = ("glb", "gltf")  # the formats that take the ``gltf`` options of write()
+COPIES = ("obj", "city.json")  # the formats whose images are copied beside them
 
 __all__ = [
     "write",
@@ -125,8 +127,10 @@ def write(
     """Write ``table`` to ``path`` in the format of its extension, or ``fmt`` when given.
 
     ``path`` ``"-"`` writes to standard output and needs ``fmt`` (not ``obj``, which is two files).
-    For ``.obj`` the ``.mtl`` is written beside it, with the same stem.  ``gltf``: options of
-    the glTF writers (``group_by``, ``instancing``; see :func:`.glb.build`), ignored by others.
+    For ``.obj`` the ``.mtl`` is written beside it, with the same stem; the images of a textured
+    ``.obj`` or ``.city.json`` are copied into ``{stem}_textures/`` beside it
+    (:mod:`.texture_files`).  ``gltf``: options of the glTF writers (``group_by``,
+    ``instancing``; see :func:`.glb.build`), ignored by others.
     """
     check_writable(table, attrs)
     options = gltf or {}
@@ -141,6 +145,11 @@ def write(
             raise BgrError(
                 "obj cannot go to standard output (it comes with a .mtl file); give a file name"
             )
+        elif name in COPIES and table.textured():
+            raise BgrError(
+                f"a textured {name} cannot go to standard output (its images are copied beside "
+                "it); give a file name"
+            )
         else:
             sys.stdout.flush()
             extra = options if name in GLTF else {}
@@ -149,11 +158,17 @@ def write(
         return
 
     name = format_of(path, fmt)
+    # OBJ and CityJSON name their images: copied into a folder beside the file (texture_files)
+    copies = None
+    if name in COPIES and table.textured():  # CityJSON has no normal maps
+        copies = Copies.of(table, texture_folder(path), (0, 1) if name == "obj" else (0,))
     if name == "obj":
         mtl = path.with_suffix(".mtl")
-        with atomic_files([path, mtl]) as (f_obj, f_mtl):
-            write_obj(table, f_obj, f_mtl, mtl_name=mtl.name, seed=seed, attrs=attrs)
+        with atomic_with_images([path, mtl], copies) as (f_obj, f_mtl):
+            write_obj(
+                table, f_obj, f_mtl, mtl_name=mtl.name, seed=seed, attrs=attrs, textures=copies
+            )
     else:
-        with atomic_files([path]) as (f,):
-            extra = options if name in GLTF else {}
+        with atomic_with_images([path], copies) as (f,):
+            extra = options if name in GLTF else {"textures": copies} if copies else {}
             FORMATS[name](table, f, seed=seed, attrs=attrs, **extra)

@@ -33,7 +33,7 @@ from bgr.grammar.errors import BgrError, Diagnostic
 from bgr.grammar.paths import read_input, resolved
 
 from .citygml_parse import RawCity, RawPolygon, RawTexture, parse_citygml
-from .cityjson import _triangulate
+from .cityjson_read import _triangulate
 from .gltf_checks import quoted
 from .textured_model import WRAPS, Material, TexturedMesh, image_path
 

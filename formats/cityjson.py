@@ -1,5 +1,5 @@
-"""CityJSON 2.0 (``.city.json``) and CityJSON Text Sequences (``.city.jsonl``): the writer, and a
-reader that gives each city object's triangles back (tests, and the inverse modules, read it).
+"""CityJSON 2.0 (``.city.json``) and CityJSON Text Sequences (``.city.jsonl``): the writer (the
+reader, which gives each city object's triangles back, is :mod:`.cityjson_read`).
 
 What the writer makes of a terminal table (docs/cli.md, "CityJSON", is the user's version):
 
@@ -22,6 +22,9 @@ What the writer makes of a terminal table (docs/cli.md, "CityJSON", is the user'
   closed Solid: grammar output rarely is.
 - **Semantics** per triangle, from the terminal's label, else the triangle's normal: see
   :func:`semantic_of_label` and :func:`semantic_types`.
+- **Appearance** (``.city.json``): the colours as materials and the colour maps as textures
+  (:mod:`.cityjson_appearance`; the images copied beside the file).  A sequence
+  (``.city.jsonl``) has neither: its features are written before the run is over.
 """
 
 from __future__ import annotations
@@ -29,19 +32,20 @@ from __future__ import annotations
 import json
 import math
 import re
-from collections.abc import Iterator
 from dataclasses import dataclass, field
-from pathlib import Path
 from typing import Any, BinaryIO
 
 import numpy as np
 
-from bgr.grammar.errors import BgrError, Diagnostic
-from bgr.grammar.paths import read_input
+from bgr.grammar.errors import BgrError
 from bgr.interpreter.terminals import TerminalTable, lot_tables
 
-from .cityjson_checks import check_indices, fan, usable
+from .cityjson_appearance import Appearance
+from .cityjson_read import CityModel as CityModel  # the reader, where it used to be
+from .cityjson_read import CityObjectMesh as CityObjectMesh
+from .cityjson_read import read_cityjson as read_cityjson
 from .meshes import bake, cross, unit_normals
+from .texture_files import Copies
 
 VERSION = "2.0"
 SCALE = 0.001  # metres per integer unit: a millimetre grid
@@ -150,6 +154,7 @@ class Triangles:
     mm: np.ndarray  # (T, 3, 3) int64: corners on the local millimetre grid
     row: np.ndarray  # (T,) the terminal each came from
     kind: np.ndarray  # (T,) semantic type, an index into SEMANTIC_TYPES
+    face: np.ndarray  # (T,) its index among the baked triangles (meshes.bake): its uvs
 
 
 def to_cityjson_axes(points: np.ndarray) -> np.ndarray:
@@ -173,6 +178,7 @@ def triangles(table: TerminalTable, lots: list[dict]) -> Triangles:
     # fewer than three distinct grid points, or three in a line: no area
     twice_area = cross((mm[:, 1] - mm[:, 0]).astype(float), (mm[:, 2] - mm[:, 0]).astype(float))
     keep = np.abs(twice_area).max(axis=1) > 0
+    face = np.flatnonzero(keep)
     mm, row, corners = mm[keep], row[keep], corners[keep]
     lot_of_row = np.repeat(
         np.arange(len(lots), dtype=np.int64), [end - first for first, end in _ranges(lots)]
@@ -182,7 +188,7 @@ def triangles(table: TerminalTable, lots: list[dict]) -> Triangles:
     np.minimum.at(base, lot, corners[:, :, 2].min(axis=1))
     normal_z = unit_normals(corners)[:, 2]
     kind = semantic_types(table.label, row, normal_z, corners[:, :, 2].max(axis=1), base[lot])
-    return Triangles(mm, row, kind)
+    return Triangles(mm, row, kind, face)
 
 
 # --------------------------------------------------------------------------------------------
@@ -380,9 +386,12 @@ def _dumps(value: Any) -> str:
     return json.dumps(value, ensure_ascii=False, allow_nan=False, separators=(",", ":"))
 
 
-def _objects(objs: list[CityObjectPlan], tris: Triangles, grid: Grid) -> tuple[str, np.ndarray]:
+def _objects(
+    objs: list[CityObjectPlan], tris: Triangles, grid: Grid, look: Appearance | None = None
+) -> tuple[str, np.ndarray]:
     """(the CityObjects member's JSON text, vertices) of some objects: the vertices their
-    triangles use, each once.  The large arrays are written as text directly."""
+    triangles use, each once.  The large arrays are written as text directly.  ``look``: the
+    surfaces' materials and textures (:mod:`.cityjson_appearance`)."""
     used = np.concatenate([o.triangles for o in objs]) if objs else np.zeros(0, np.int64)
     points = tris.mm[used].reshape(-1, 3) - grid.low
     low = points.min(axis=0) if len(points) else np.zeros(3, np.int64)
@@ -408,7 +417,9 @@ def _objects(objs: list[CityObjectPlan], tris: Triangles, grid: Grid) -> tuple[s
                 f'{{"type":"MultiSurface","lod":"{lod}",'
                 f'"boundaries":{_rows_text(index[at : at + n], "[[%d,%d,%d]]")},'
                 f'"semantics":{{"surfaces":{_dumps(semantics["surfaces"])},'
-                f'"values":{_rows_text(semantics["values"][:, None], "%d")}}}}}'
+                f'"values":{_rows_text(semantics["values"][:, None], "%d")}}}'
+                + (look.geometry_text(o.triangles) if look else "")
+                + "}"
             )
             text = text[:-1] + f',"geometry":[{geometry}]}}'
         at += n
@@ -440,11 +451,25 @@ def _prepare(table: TerminalTable, attrs: dict) -> tuple[Triangles, list, Grid, 
     return tris, plan(table, tris, lots), grid, _dumps(head)[:-1]
 
 
-def write_cityjson(table: TerminalTable, stream: BinaryIO, *, seed: int, attrs: dict) -> None:
-    """The whole table as one CityJSON 2.0 document (the module's docstring says how)."""
+def write_cityjson(
+    table: TerminalTable,
+    stream: BinaryIO,
+    *,
+    seed: int,
+    attrs: dict,
+    textures: Copies | None = None,
+) -> None:
+    """The whole table as one CityJSON 2.0 document (the module's docstring says how), with
+    its ``appearance``: the colours as materials, and the colour maps as textures where
+    ``textures`` names the images' copies (:func:`bgr.formats.write` makes them)."""
     tris, buildings, grid, head = _prepare(table, attrs)
-    objects, vertices = _objects([o for b in buildings for o in b], tris, grid)
-    text = f'{head},"CityObjects":{objects},"vertices":{_rows_text(vertices, "[%d,%d,%d]")}}}\n'
+    look = Appearance.of(table, tris.row, tris.face, textures) if len(tris.row) else None
+    objects, vertices = _objects([o for b in buildings for o in b], tris, grid, look)
+    text = (
+        f'{head},"CityObjects":{objects},"vertices":{_rows_text(vertices, "[%d,%d,%d]")}'
+        + (look.text() if look else "")
+        + "}\n"
+    )
     stream.write(text.encode("utf-8"))
 
 
@@ -494,189 +519,3 @@ class SequenceWriter:
                 f'"vertices":{_rows_text(vertices, "[%d,%d,%d]")}}}\n'
             )
             self.stream.write(text.encode("utf-8"))
-
-
-# --------------------------------------------------------------------------------------------
-# reading
-
-
-@dataclass
-class CityObjectMesh:
-    """One city object read back: its triangles in the file's coordinates (z up, transform
-    applied), each with its semantic type (None where the file gives none) and the index of the
-    surface it covers part of (surfaces counted in the order of the boundaries, shells and
-    solids flattened)."""
-
-    id: str
-    type: str
-    vertices: np.ndarray  # (V, 3) float64, only the vertices its triangles use
-    faces: np.ndarray  # (F, 3) int64 into vertices, counter-clockwise seen from outside
-    semantics: list[str | None]
-    surface: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=np.int64))  # (F,)
-    lod: str | None = None
-    attributes: dict = field(default_factory=dict)
-    parents: list[str] = field(default_factory=list)
-    children: list[str] = field(default_factory=list)
-
-
-@dataclass
-class CityModel:
-    """A CityJSON file read back: its objects by id, the CRS URL it names, its transform."""
-
-    objects: dict[str, CityObjectMesh]
-    reference_system: str | None = None
-    transform: dict | None = None
-
-
-def read_cityjson(path: str | Path, lod: str | None = None) -> CityModel:
-    """Read a ``.city.json`` (or a ``.city.jsonl`` sequence) into triangles per city object.
-
-    Of each object's geometries the one of ``lod`` is read (default: its highest lod);
-    MultiSurface, CompositeSurface, Solid, MultiSolid and CompositeSolid are read, every
-    surface triangulated (earcut, holes kept) and turned to face where its outer ring does;
-    points, lines and GeometryInstances (templates) are not, nor appearances.  An object
-    without such geometry has no triangles.  BgrError, naming the file, when it is not CityJSON
-    this reader can use."""
-    shown = str(path)
-    try:
-        text = read_input(path, "CityJSON file").decode("utf-8")
-    except FileNotFoundError:
-        raise BgrError(Diagnostic(shown, 0, 0, "no such CityJSON file")) from None
-    except (OSError, UnicodeDecodeError) as exc:
-        raise BgrError(Diagnostic(shown, 0, 0, f"cannot read the CityJSON file: {exc}")) from None
-    try:
-        if shown.lower().endswith(".jsonl"):  # CityJSON Text Sequences: one object a line
-            lines = [json.loads(line) for line in text.splitlines() if line.strip()]
-            head, features = (lines or [None])[0], lines[1:]
-        else:
-            head, features = _parse(shown, text), []
-        if not isinstance(head, dict) or head.get("type") != "CityJSON":
-            raise ValueError("the first object is not of type CityJSON")
-        transform = head.get("transform")
-        model = CityModel({}, (head.get("metadata") or {}).get("referenceSystem"), transform)
-        for doc in [head, *features]:
-            if "vertices" not in doc:  # required of every CityJSON object and feature
-                raise ValueError('it has no "vertices"')
-            vertices = np.asarray(doc.get("vertices") or np.zeros((0, 3)), dtype=np.float64)
-            if transform:
-                with np.errstate(over="ignore", invalid="ignore"):  # inf: named further on
-                    vertices = vertices * transform["scale"] + transform["translate"]
-            vertices = vertices.reshape(-1, 3)
-            for ident, obj in doc["CityObjects"].items():
-                try:
-                    model.objects[ident] = _read_object(ident, obj, vertices, lod)
-                except ValueError as exc:
-                    raise ValueError(f"city object {ident[:80]!r}: {exc}") from None
-        return model
-    except (
-        ValueError, KeyError, TypeError, IndexError, AttributeError, RecursionError, OverflowError
-    ) as exc:  # fmt: skip
-        raise BgrError(
-            Diagnostic(shown, 0, 0, f"not a CityJSON file this reader can use: {exc}")
-        ) from None
-
-
-def _parse(shown: str, text: str) -> Any:
-    """The JSON of a .city.json; a BgrError at the line and column where it stops parsing."""
-    try:
-        return json.loads(text)
-    except json.JSONDecodeError as exc:
-        raise BgrError(
-            Diagnostic(shown, exc.lineno, exc.colno, f"not a CityJSON file: not JSON: {exc.msg}")
-        ) from None
-
-
-def _lod_key(lod: Any) -> float:
-    try:
-        return float(lod)
-    except (TypeError, ValueError):
-        return -1.0
-
-
-# how deep surfaces sit in the boundaries of each kind of geometry this reader reads
-_DEPTH = {
-    "MultiSurface": 0,
-    "CompositeSurface": 0,
-    "Solid": 1,
-    "MultiSolid": 2,
-    "CompositeSolid": 2,
-}
-
-
-def _read_object(ident: str, obj: dict, vertices: np.ndarray, lod: str | None) -> CityObjectMesh:
-    geoms = [g for g in obj.get("geometry") or [] if g.get("type") in _DEPTH]
-    if lod is not None:
-        geoms = [g for g in geoms if str(g.get("lod")) == str(lod)]
-    out = CityObjectMesh(
-        ident,
-        obj["type"],
-        np.zeros((0, 3)),
-        np.zeros((0, 3), dtype=np.int64),
-        [],
-        attributes=dict(obj.get("attributes") or {}),
-        parents=list(obj.get("parents") or []),
-        children=list(obj.get("children") or []),
-    )
-    if not geoms:
-        return out
-    geom = max(geoms, key=lambda g: _lod_key(g.get("lod")))
-    out.lod = None if geom.get("lod") is None else str(geom["lod"])
-    surfaces = list(_surfaces(geom))
-    names = [s["type"] for s in (geom.get("semantics") or {}).get("surfaces", [])]
-    faces, kinds, counts = [], [], []
-    for rings, value in surfaces:
-        tri = _triangulate(vertices, rings)
-        faces.append(tri)
-        counts.append(len(tri))
-        kinds += [names[value] if value is not None else None] * len(tri)
-    flat = np.concatenate(faces) if faces else np.zeros((0, 3), dtype=np.int64)
-    used, inverse = np.unique(flat.reshape(-1), return_inverse=True)
-    out.vertices = vertices[used]
-    out.faces = inverse.reshape(-1, 3).astype(np.int64)
-    out.semantics = kinds
-    out.surface = np.repeat(np.arange(len(counts), dtype=np.int64), counts)
-    return out
-
-
-def _surfaces(geom: dict) -> Iterator[tuple[list, int | None]]:
-    """(rings, semantic value) of every surface of a geometry, whatever its nesting."""
-    depth = _DEPTH[geom["type"]]
-    values = (geom.get("semantics") or {}).get("values")
-
-    def walk(bounds: list, vals: Any, level: int) -> Iterator[tuple[list, int | None]]:
-        for i, item in enumerate(bounds):
-            sub = vals[i] if isinstance(vals, list) and i < len(vals) else None
-            if level == 0:
-                yield item, sub if isinstance(sub, int) else None
-            else:
-                yield from walk(item, sub, level - 1)
-
-    yield from walk(geom["boundaries"], values, depth)
-
-
-def _triangulate(vertices: np.ndarray, rings: list) -> np.ndarray:
-    """Triangles (k, 3) of vertex indices covering one surface (outer ring, then holes),
-    facing where the outer ring's Newell normal does."""
-    outer = np.asarray(rings[0], dtype=np.int64)
-    if len(rings) == 1 and len(outer) == 3:
-        if not 0 <= min(rings[0]) <= max(rings[0]) < len(vertices):  # builtins: 3 numbers
-            check_indices(outer, len(vertices))
-        return outer[None, :]
-    import mapbox_earcut
-
-    index = np.concatenate([np.asarray(r, dtype=np.int64) for r in rings])
-    check_indices(index, len(vertices))
-    points = vertices[index]
-    if not usable(points):  # earcut (C++) and the normals must not see it; the caller names it
-        return fan(outer)
-    ring = vertices[outer]
-    normal = np.sum(cross(ring, np.roll(ring, -1, axis=0)), axis=0)  # Newell
-    drop = int(np.argmax(np.abs(normal)))
-    flat = np.delete(points, drop, axis=1)
-    ends = np.cumsum([len(r) for r in rings]).astype(np.uint32)
-    tri = index[mapbox_earcut.triangulate_float64(flat, ends).reshape(-1, 3).astype(np.int64)]
-    if len(tri):
-        corners = vertices[tri]
-        facing = cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0]) @ normal
-        tri[facing < 0] = tri[facing < 0][:, ::-1]
-    return tri

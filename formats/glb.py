@@ -41,15 +41,13 @@ import numpy as np
 from bgr.grammar.errors import BgrError
 from bgr.interpreter.terminals import TerminalTable, lot_tables
 
+from .gltf_materials import MaterialIndex, UvSets, image_members
 from .instancing import CORNER_BYTES, INSTANCE_BYTES, plan, quaternions
-from .materials import Materials, materials_of
 from .meshes import MeshPool, bounds, face_offsets, place_corners, unit_normals
 from .terminal_json import plain
-from .texcoords import corner_uvs, texture_keys
 
 INSTANCING = "EXT_mesh_gpu_instancing"
 FLOAT, ARRAY_BUFFER = 5126, 34962
-LINEAR, REPEAT = 9729, 10497
 __all__ = ["Scene", "build", "write_glb", "write_gltf", "quaternions", "plan", "recentre"]
 
 
@@ -174,61 +172,6 @@ def lot_rows(table: TerminalTable) -> np.ndarray:
     return out
 
 
-class MaterialIndex:
-    """The file's materials, in first-use order over every part added: each part's
-    :class:`Materials` gets the file's material numbers as its ``index``."""
-
-    def __init__(self) -> None:
-        self.numbers: dict[tuple, int] = {}
-        self.names: list[str | None] = []
-        self.rgb8: list[np.ndarray] = []
-        # per material: (colour map, normal map) image paths, None for none (texcoords.py)
-        self.textures: list[tuple[str | None, str | None]] = []
-
-    def __len__(self) -> int:
-        return len(self.names)
-
-    def of(self, table: TerminalTable) -> Materials:
-        local = materials_of(table)
-        number = np.empty(len(local), dtype=np.int64)
-        for k, name in enumerate(local.names):
-            key = (name, *(int(c) for c in local.rgb8[k]))
-            if key not in self.numbers:
-                self.numbers[key] = len(self.names)
-                self.names.append(name)
-                self.rgb8.append(local.rgb8[k])
-                self.textures.append((None, None))
-            number[k] = self.numbers[key]
-        local.index = number[local.index] if len(local.index) else local.index
-        if len(table.tex_rows):  # a textured terminal's material also names its images
-            keys = texture_keys(table)
-            for row in np.asarray(table.tex_rows).tolist():
-                k = int(local.index[row])
-                key = (self.names[k], *(int(c) for c in self.rgb8[k]), *keys[row])
-                if key not in self.numbers:
-                    self.numbers[key] = len(self.names)
-                    self.names.append(self.names[k])
-                    self.rgb8.append(self.rgb8[k])
-                    self.textures.append(keys[row])
-                local.index[row] = self.numbers[key]
-        return local
-
-    def all(self) -> Materials:
-        """Every material so far, with its display label (which needs all of them)."""
-        rgb8 = np.array(self.rgb8, dtype=np.uint8).reshape(-1, 3)
-        per_name: dict[str | None, int] = {}
-        for n in self.names:
-            per_name[n] = per_name.get(n, 0) + 1
-        labels = []
-        for k, n in enumerate(self.names):
-            hx = "#" + "".join(f"{int(c):02x}" for c in rgb8[k])
-            label = hx if n is None else (n if per_name[n] == 1 else f"{n} {hx}")
-            if self.textures[k] != (None, None):  # the image's file name tells them apart
-                label += " " + " ".join(p.rsplit("/", 1)[-1] for p in self.textures[k] if p)
-            labels.append(label)
-        return Materials(np.zeros(0, np.int64), rgb8, list(self.names), labels)
-
-
 SPOOL_MEMORY = 1 << 20  # bytes a spool holds in memory before it moves to a temporary file
 
 
@@ -338,17 +281,8 @@ class Scene:
         new_images = [im for im in table.images if im.path not in self.images]
         new_images = [im for k, im in enumerate(new_images) if im not in new_images[:k]]
         nbytes += sum(len(im.data) + (-len(im.data) % 4) for im in new_images)
-        textured = self.materials.textures
-        uv_rows = (
-            [r for r in p.baked.tolist() if textured[int(mats.index[r])] != (None, None)]
-            if len(table.tex_rows)
-            else []
-        )
-        n_uv = 3 * int(face_offsets(table, np.asarray(uv_rows, np.int64), pool)[-1])
-        has_normal = {k for k, t in enumerate(textured) if t[1] is not None}
-        normal_rows = [r for r in uv_rows if int(mats.index[r]) in has_normal]
-        n_nuv = 3 * int(face_offsets(table, np.asarray(normal_rows, np.int64), pool)[-1])
-        nbytes += (n_uv + n_nuv) * 8
+        uvs = UvSets.of(table, p.baked, mats, self.materials.textures, pool)
+        nbytes += uvs.nbytes
         for mesh_id, _, rows in p.groups:
             nbytes += int(pool.fcount[mesh_id]) * 3 * CORNER_BYTES + len(rows) * INSTANCE_BYTES
         b = _Builder(nbytes, (sp["bin"].nbytes, sp["views"].count, sp["accessors"].count))
@@ -356,22 +290,7 @@ class Scene:
             self.image_alpha[im.path] = im.alpha
             self.images[im.path] = len(self.image_views)
             self.image_views.append((b.raw(im.data), im.mime))
-        uv_at: dict[int, int] = {}  # corner offset of each textured row's first uv
-        if uv_rows:
-            at = 0
-            for r in uv_rows:
-                uv_at[r] = at
-                at += 3 * int(pool.fcount[table.mesh[r]])
-            uv_off, uv_data = b.block(n_uv, 2)
-            uv_data[:] = corner_uvs(table, np.asarray(uv_rows), pool, 0)
-        nuv_at: dict[int, int] = {}
-        if normal_rows:
-            at = 0
-            for r in normal_rows:
-                nuv_at[r] = at
-                at += 3 * int(pool.fcount[table.mesh[r]])
-            nuv_off, nuv_data = b.block(n_nuv, 2)
-            nuv_data[:] = corner_uvs(table, np.asarray(normal_rows), pool, 1)
+        uvs.fill(b.block, table, pool)
 
         # baked terminals: one primitive per (group, material), a slice of two big blocks
         prims: list[list[dict]] = [[] for _ in groups.name]
@@ -400,16 +319,7 @@ class Scene:
                         ),
                         "NORMAL": b.accessor(nrm_at + first * 12, nrm_data[first:end]),
                     }
-                    if int(row) in uv_at:  # a textured material: its rows are consecutive
-                        u0 = uv_at[int(row)]
-                        attributes["TEXCOORD_0"] = b.accessor(
-                            uv_off + u0 * 8, uv_data[u0 : u0 + end - first]
-                        )
-                    if int(row) in nuv_at:
-                        u1 = nuv_at[int(row)]
-                        attributes["TEXCOORD_1"] = b.accessor(
-                            nuv_off + u1 * 8, nuv_data[u1 : u1 + end - first]
-                        )
+                    attributes.update(uvs.attributes(int(row), end - first, b.accessor))
                     prims[int(groups.of_row[row])].append(
                         {"attributes": attributes, "material": int(mats.index[row]), "mode": 4}
                     )
@@ -515,40 +425,11 @@ class Scene:
         if sp["meshes"].count:
             pieces += [b',"meshes":[', sp["meshes"], b"]"]
         if self.used:
-            mats = self.materials.all()
-            materials: list[dict] = [
-                {
-                    "name": mats.labels[k],
-                    "pbrMetallicRoughness": {
-                        "baseColorFactor": mats.linear(k) + [1.0],
-                        "metallicFactor": 0.0,
-                        "roughnessFactor": 0.8,
-                    },
-                    "doubleSided": True,
-                    "extras": {"color": mats.hex(k), "material": mats.names[k]},
-                }
-                for k in range(len(mats))
-            ]
-            for k, (color, normal) in enumerate(self.materials.textures):
-                if color is not None:
-                    pbr: dict = materials[k]["pbrMetallicRoughness"]
-                    pbr["baseColorTexture"] = {"index": self.images[color]}
-                    if self.image_alpha.get(color):
-                        materials[k]["alphaMode"] = "BLEND"
-                if normal is not None:
-                    materials[k]["normalTexture"] = {"index": self.images[normal], "texCoord": 1}
+            materials = self.materials.members(self.images, self.image_alpha)
             pieces.append(b',"materials":' + _json_bytes(materials))
         if self.image_views:  # a texture per image, all with one repeating sampler
-            pieces.append(
-                b',"textures":'
-                + _json_bytes([{"sampler": 0, "source": k} for k in range(len(self.image_views))])
-                + b',"images":'
-                + _json_bytes([{"bufferView": v, "mimeType": m} for v, m in self.image_views])
-                + b',"samplers":'
-                + _json_bytes(
-                    [{"magFilter": LINEAR, "minFilter": LINEAR, "wrapS": REPEAT, "wrapT": REPEAT}]
-                )
-            )
+            for key, value in image_members(self.image_views):
+                pieces.append(f',"{key}":'.encode() + _json_bytes(value))
         if sp["accessors"].count:
             pieces += [b',"accessors":[', sp["accessors"], b'],"bufferViews":[', sp["views"]]
             pieces.append(b'],"buffers":' + _json_bytes([{"byteLength": sp["bin"].nbytes}]))

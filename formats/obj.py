@@ -5,16 +5,23 @@ Layout of the file::
     # bgr seed 3
     mtllib house.mtl
     vn 0 0 1                 every distinct face normal, once for the whole file
+    vt 0.5 1                 every distinct texture coordinate, once (textured terminals)
     o lot-0                  one object per lot (its GeoJSON feature id, or lot-N)
     v 1.5 0 -2.25            the object's vertices: each distinct position once
     g Wall                   one group per terminal label
     usemtl brick             the material of the faces that follow
     f 1//1 2//1 3//1         triangles: vertex//normal, counter-clockwise seen from outside
+    f 4/1/2 5/2/2 6/3/2      a textured triangle: vertex/texture coordinate/normal
 
 Triangles are flat shaded: a face normal per triangle, pointing out as its winding says (mirrored
 terminals are re-wound, as in the GLB).  Where faces meet at a position they share its ``v``;
 positions and normals are written with six decimals (micrometres), and two positions that print
 the same are one vertex.
+
+A textured terminal's faces have a ``vt`` per corner: each distinct texture coordinate is written
+once, after the normals, v up the image (OBJ's way and CGA's, glTF's upside down); its material
+names the images, copied beside the file (:mod:`.texture_files`), in ``map_Kd``, ``map_d`` and
+``map_Bump``.
 
 Names are one word: anything that is not a letter, digit, ``-``, ``_`` or ``.`` becomes ``_``
 (``#`` starts a comment), and a name already taken gets ``_`` appended.  Materials are named as in
@@ -27,16 +34,20 @@ from __future__ import annotations
 
 import re
 from collections.abc import Callable
+from pathlib import Path
 from typing import BinaryIO
 
 import numpy as np
 
 from bgr.interpreter.terminals import TerminalTable
 
+from .gltf_materials import MaterialIndex
 from .materials import Materials, materials_of
-from .meshes import bake, unit_normals
+from .meshes import Baked, MeshPool, bake, unit_normals
 from .sharing import number_rows
+from .texcoords import baked_uvs
 from .text import decimal, gather, integer, left_aligned, line_starts, quantize, render, word
+from .texture_files import Copies, texture_folder
 
 LINES_PER_BLOCK = 1 << 17  # lines formatted at once: bounds the memory of a large file
 
@@ -91,8 +102,9 @@ def codes(values: list[str]) -> tuple[np.ndarray, list[str]]:
 
 
 def _point_lines(prefix: bytes, q: np.ndarray) -> bytes:
-    """``v x y z`` lines (``prefix`` ``v `` or ``vn ``) of (n, 3) quantized points."""
-    numbers = [decimal(q[:, k], prefix if k == 0 else b" ") for k in range(3)]
+    """``v x y z`` lines (``prefix`` ``v ``, ``vn `` or ``vt ``) of (n, 3) or (n, 2) quantized
+    points."""
+    numbers = [decimal(q[:, k], prefix if k == 0 else b" ") for k in range(q.shape[1])]
     grid = np.empty((len(q), sum(w.shape[1] + 1 for w, _ in numbers)), dtype=np.uint64)
     at = 0
     for whole, frac in numbers:
@@ -143,15 +155,35 @@ def runs(keys: np.ndarray, fstart: np.ndarray) -> list[tuple[int, int, int, int,
 
 
 def write_obj(
-    table: TerminalTable, stream: BinaryIO, mtl: BinaryIO, *, mtl_name: str, seed: int, attrs: dict
+    table: TerminalTable,
+    stream: BinaryIO,
+    mtl: BinaryIO,
+    *,
+    mtl_name: str,
+    seed: int,
+    attrs: dict,
+    textures: Copies | None = None,
 ) -> None:
-    """Write the terminals as OBJ to ``stream`` and their materials as MTL to ``mtl``."""
+    """Write the terminals as OBJ to ``stream`` and their materials as MTL to ``mtl``.
+
+    A textured table's MTL names its images as ``textures`` says (where :func:`bgr.formats.write`
+    copies them; by default ``{stem}_textures/{image}``, which the caller must then write)."""
     table.freeze()
-    mats = materials_of(table)
+    maps: list[tuple[str | None, str | None]] = []
+    if table.textured():  # a material per (colour, name, images), as the GLB has
+        index = MaterialIndex()
+        local = index.of(table)
+        mats, maps = index.all(), index.textures
+        mats.index = local.index
+        if textures is None:
+            textures = Copies.of(table, texture_folder(Path(mtl_name).stem + ".obj"))
+    else:
+        mats = materials_of(table)
     lot_of, objects = lot_names(table)
     label_of, labels = codes(list(table.label))
     rows = np.lexsort((np.arange(len(table)), mats.index, label_of, lot_of))  # the file's order
-    baked = bake(table, rows)
+    pool = MeshPool.of(table)
+    baked = bake(table, rows, pool)
 
     # vertices: one per distinct (object, written position) that a face uses, in file order
     used = np.zeros(len(baked.vertices), dtype=bool)
@@ -168,20 +200,31 @@ def write_obj(
     # normals: one per distinct written face normal, for the whole file
     nq = quantize(unit_normals(np.take(baked.vertices, baked.faces, axis=0)))
     nid, nfirst = number_rows([nq[:, 0], nq[:, 1], nq[:, 2]])
-    normal_text = left_aligned(integer(np.arange(1, len(nfirst) + 1), b"//"))
+    # texture coordinates: one vt per distinct written uv, for the whole file; -1: none
+    vt, tq = texture_corners(table, rows, pool, baked)
+    slashes = b"/" if len(tq) else b"//"
+    normal_text = left_aligned(integer(np.arange(1, len(nfirst) + 1), slashes))
+    vt_text = np.zeros((0, 1), dtype=np.uint64)
+    if len(tq):  # "/k", and "/" first for a corner without one (its face reads v//vn)
+        vt_text = left_aligned(integer(np.arange(0, len(tq) + 1), b"/"))
+        vt_text[0] = 0
+        vt_text[0, 0] = word(b"/")
 
     def f_lines(lo: int, hi: int) -> bytes:
         c = corners[lo:hi]
         first = int(c.min(initial=0))  # the vertex numbers of a block, formatted once each
         v_text = integer(np.arange(first + 1, int(c.max(initial=0)) + 2))
         vn = gather(normal_text, nid[lo:hi])
-        wv, wn = v_text.shape[1], vn.shape[1]
-        grid = np.empty((hi - lo, 2 + 3 * (wv + wn)), dtype=np.uint64)
+        wv, wt, wn = v_text.shape[1], vt_text.shape[1] if len(tq) else 0, vn.shape[1]
+        width = wv + wt + wn
+        grid = np.empty((hi - lo, 2 + 3 * width), dtype=np.uint64)
         grid[:, 0] = word(b"f")
         for k in range(3):
-            at = 1 + k * (wv + wn)
+            at = 1 + k * width
             grid[:, at : at + wv] = gather(v_text, c[:, k] - first)
-            grid[:, at + wv : at + wv + wn] = vn
+            if wt:
+                grid[:, at + wv : at + wv + wt] = gather(vt_text, vt[lo:hi, k] + 1)
+            grid[:, at + wv + wt : at + width] = vn
         grid[:, -1] = word(b"\n")
         return render(grid)
 
@@ -189,6 +232,7 @@ def write_obj(
     _Blocks(len(nfirst), lambda lo, hi: _point_lines(b"vn ", nq[nfirst[lo:hi]])).write(
         stream, 0, len(nfirst)
     )
+    _Blocks(len(tq), lambda lo, hi: _point_lines(b"vt ", tq[lo:hi])).write(stream, 0, len(tq))
     v_lines = _Blocks(len(vpos), lambda lo, hi: _point_lines(b"v ", vpos[lo:hi]))
     f_blocks = _Blocks(len(corners), f_lines)
     groups, materials = unique_names(labels), obj_names(mats)
@@ -203,11 +247,39 @@ def write_obj(
         current = (obj, label)
         stream.write(f"usemtl {materials[mat]}\n".encode())
         f_blocks.write(stream, lo, hi)
-    mtl.write(mtl_text(mats, materials))
+    alpha = {image.path: image.alpha for image in table.images}
+    mtl.write(mtl_text(mats, materials, maps, textures.names if textures else {}, alpha))
 
 
-def mtl_text(mats: Materials, names: list[str]) -> bytes:
-    """The .mtl: each material's sRGB colour as ``Kd``, no ambient or specular light."""
+def texture_corners(
+    table: TerminalTable, rows: np.ndarray, pool: MeshPool, baked: Baked
+) -> tuple[np.ndarray, np.ndarray]:
+    """(each face corner's vt number, -1 for none; the distinct uvs quantized, in the order
+    the file lists them) of the faces of ``rows`` as baked.  v runs up the image (OBJ's way,
+    and CGA's)."""
+    corners = np.full((len(baked.faces), 3), -1, dtype=np.int64)
+    if not table.textured():
+        return corners, np.zeros((0, 2), dtype=np.int64)
+    textured = np.zeros(len(table), dtype=bool)
+    textured[table.tex_rows] = True
+    mine = textured[rows]
+    uq = quantize(baked_uvs(table, rows[mine], pool).reshape(-1, 2))
+    tid, tfirst = number_rows([uq[:, 0], uq[:, 1]])
+    corners[np.repeat(mine, np.diff(baked.fstart))] = tid.reshape(-1, 3)
+    return corners, uq[tfirst]
+
+
+def mtl_text(
+    mats: Materials,
+    names: list[str],
+    maps: list[tuple[str | None, str | None]] | None = None,
+    files: dict[str, str] | None = None,
+    alpha: dict[str, bool] | None = None,
+) -> bytes:
+    """The .mtl: each material's sRGB colour as ``Kd``, no ambient or specular light; a
+    textured material (``maps``: its colour and normal map paths) names its images by their
+    copies' paths (``files``): ``map_Kd`` the colour map, ``map_d`` it again when it has alpha
+    (its opacity), ``map_Bump`` and ``bump`` the normal map."""
     lines = ["# bgr materials"]
     for k, name in enumerate(names):
         r, g, b = (c / 255.0 for c in mats.rgb8[k])
@@ -218,6 +290,13 @@ def mtl_text(mats: Materials, names: list[str]) -> bytes:
             "Ks 0 0 0",
             "d 1",
             "illum 1",
-            "",
         ]
+        color, normal = maps[k] if maps else (None, None)
+        if color is not None and files:
+            lines.append(f"map_Kd {files[color]}")
+            if alpha and alpha.get(color):
+                lines.append(f"map_d {files[color]}")
+        if normal is not None and files:
+            lines += [f"map_Bump {files[normal]}", f"bump {files[normal]}"]
+        lines.append("")
     return "\n".join(lines).encode("utf-8")

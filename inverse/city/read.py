@@ -707,7 +707,7 @@ def _convex(points: np.ndarray) -> np.ndarray:
 
 
 def _earcut(vertices: np.ndarray, ring: np.ndarray) -> np.ndarray:
-    from bgr.formats.cityjson import _triangulate
+    from bgr.formats.cityjson_read import _triangulate
 
     return _triangulate(vertices, [ring.tolist()])
 
@@ -864,7 +864,7 @@ def _read_cityjson(path: str | Path, lod: str | None) -> Found:
     """Every city object with triangles: Buildings and BuildingParts to proceduralize, the
     rest (roads, land use, water, terrain...) carried.  A Building whose geometry is all in
     its BuildingParts has no triangles of its own, so only its parts are objects."""
-    from bgr.formats.cityjson import read_cityjson
+    from bgr.formats.cityjson_read import read_cityjson
 
     model = read_cityjson(path, lod)
     vertices, faces, owner = [], [], []

@@ -1,0 +1,197 @@
+"""The glTF file's materials and textures: which material each terminal gets, the ``materials``,
+``textures``, ``images`` and ``samplers`` members, and the texture coordinates of textured
+primitives.  Kept apart from :mod:`.glb` (the scene, its nodes and buffer) because this is the
+one part of the file that depends on colours and images rather than geometry.
+
+* one material per distinct (colour, material name) pair, and per textured pair one per distinct
+  (colour map, normal map), in first-use order over the whole file (:class:`MaterialIndex`);
+* a material with a colour map has ``baseColorTexture`` (and ``alphaMode`` BLEND when the image
+  has alpha); one with a normal map ``normalTexture`` on TEXCOORD_1;
+* a texture per image, all with one sampler that repeats (CGA's tiles run past 0..1).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from bgr.interpreter.terminals import TerminalTable
+
+from .materials import Materials, materials_of
+from .meshes import MeshPool, face_offsets
+from .texcoords import corner_uvs
+
+LINEAR, REPEAT = 9729, 10497
+
+
+class MaterialIndex:
+    """The file's materials, in first-use order over every part added: each part's
+    :class:`Materials` gets the file's material numbers as its ``index``."""
+
+    def __init__(self) -> None:
+        self.numbers: dict[tuple, int] = {}
+        self.names: list[str | None] = []
+        self.rgb8: list[np.ndarray] = []
+        # per material: (colour map, normal map) image paths, None for none (texcoords.py)
+        self.textures: list[tuple[str | None, str | None]] = []
+
+    def __len__(self) -> int:
+        return len(self.names)
+
+    def of(self, table: TerminalTable) -> Materials:
+        local = materials_of(table)
+        number = np.empty(len(local), dtype=np.int64)
+        for k, name in enumerate(local.names):
+            key = (name, *(int(c) for c in local.rgb8[k]))
+            if key not in self.numbers:
+                self.numbers[key] = len(self.names)
+                self.names.append(name)
+                self.rgb8.append(local.rgb8[k])
+                self.textures.append((None, None))
+            number[k] = self.numbers[key]
+        local.index = number[local.index] if len(local.index) else local.index
+        if len(table.tex_rows):  # a textured terminal's material also names its images
+            self._textured(table, local)
+        return local
+
+    def _textured(self, table: TerminalTable, local: Materials) -> None:
+        """Give the textured rows the materials of their (colour, name, colour map, normal
+        map), numbered in first-use order: a Python step per distinct combination, not per
+        row."""
+        rows = np.asarray(table.tex_rows, dtype=np.int64)
+        maps = np.asarray(table.tex_maps, dtype=np.int64).reshape(-1, 2) + 1  # 0: none
+        n_images = len(table.images) + 1
+        code = (local.index[rows] * n_images + maps[:, 0]) * n_images + maps[:, 1]
+        combos, first, inverse = np.unique(code, return_index=True, return_inverse=True)
+        number = np.empty(len(combos), dtype=np.int64)
+        paths = [None, *(image.path for image in table.images)]
+        for j in np.argsort(first, kind="stable").tolist():  # in order of first use
+            row = int(first[j])
+            k = int(local.index[rows[row]])
+            images = (paths[int(maps[row, 0])], paths[int(maps[row, 1])])
+            key = (self.names[k], *(int(c) for c in self.rgb8[k]), *images)
+            if key not in self.numbers:
+                self.numbers[key] = len(self.names)
+                self.names.append(self.names[k])
+                self.rgb8.append(self.rgb8[k])
+                self.textures.append(images)
+            number[j] = self.numbers[key]
+        local.index[rows] = number[inverse.reshape(-1)]
+
+    def all(self) -> Materials:
+        """Every material so far, with its display label (which needs all of them)."""
+        rgb8 = np.array(self.rgb8, dtype=np.uint8).reshape(-1, 3)
+        per_name: dict[str | None, int] = {}
+        for n in self.names:
+            per_name[n] = per_name.get(n, 0) + 1
+        labels = []
+        for k, n in enumerate(self.names):
+            hx = "#" + "".join(f"{int(c):02x}" for c in rgb8[k])
+            label = hx if n is None else (n if per_name[n] == 1 else f"{n} {hx}")
+            if self.textures[k] != (None, None):  # the image's file name tells them apart
+                label += " " + " ".join(p.rsplit("/", 1)[-1] for p in self.textures[k] if p)
+            labels.append(label)
+        return Materials(np.zeros(0, np.int64), rgb8, list(self.names), labels)
+
+    def members(self, images: dict[str, int], alpha: dict[str, bool]) -> list[dict]:
+        """The ``materials`` member: PBR, the colour in linear light, its maps as textures
+        (``images``: an image path's texture number; ``alpha``: whether it has alpha)."""
+        mats = self.all()
+        materials: list[dict] = [
+            {
+                "name": mats.labels[k],
+                "pbrMetallicRoughness": {
+                    "baseColorFactor": mats.linear(k) + [1.0],
+                    "metallicFactor": 0.0,
+                    "roughnessFactor": 0.8,
+                },
+                "doubleSided": True,
+                "extras": {"color": mats.hex(k), "material": mats.names[k]},
+            }
+            for k in range(len(mats))
+        ]
+        for k, (color, normal) in enumerate(self.textures):
+            if color is not None:
+                pbr: dict = materials[k]["pbrMetallicRoughness"]
+                pbr["baseColorTexture"] = {"index": images[color]}
+                if alpha.get(color):
+                    materials[k]["alphaMode"] = "BLEND"
+            if normal is not None:
+                materials[k]["normalTexture"] = {"index": images[normal], "texCoord": 1}
+        return materials
+
+
+def image_members(image_views: list[tuple[int, str]]) -> list[tuple[str, list[dict]]]:
+    """The ``textures``, ``images`` and ``samplers`` members, in that order: a texture per
+    image (``image_views``: its bufferView and mimeType), all with one repeating sampler."""
+    return [
+        ("textures", [{"sampler": 0, "source": k} for k in range(len(image_views))]),
+        ("images", [{"bufferView": v, "mimeType": m} for v, m in image_views]),
+        (
+            "samplers",
+            [{"magFilter": LINEAR, "minFilter": LINEAR, "wrapS": REPEAT, "wrapT": REPEAT}],
+        ),
+    ]
+
+
+@dataclass
+class UvSets:
+    """The texture coordinates of one part's textured primitives: per set (0: the colour map's,
+    TEXCOORD_0; 1: the normal map's, TEXCOORD_1) the rows that need it in file order, where
+    each row's first corner sits in the set's block, and the block once filled."""
+
+    rows: list[list[int]]
+    at: list[dict[int, int]]
+    corners: list[int]
+    blocks: list[tuple[int, np.ndarray]] = field(default_factory=list)
+
+    @classmethod
+    def of(
+        cls,
+        table: TerminalTable,
+        baked: np.ndarray,
+        mats: Materials,
+        textures: list[tuple[str | None, str | None]],
+        pool: MeshPool,
+    ) -> UvSets:
+        uv_rows = (
+            [r for r in baked.tolist() if textures[int(mats.index[r])] != (None, None)]
+            if len(table.tex_rows)
+            else []
+        )
+        has_normal = {k for k, t in enumerate(textures) if t[1] is not None}
+        normal_rows = [r for r in uv_rows if int(mats.index[r]) in has_normal]
+        rows, at, corners = [uv_rows, normal_rows], [], []
+        for chosen in rows:
+            starts = 3 * face_offsets(table, np.asarray(chosen, np.int64), pool)
+            at.append(dict(zip(chosen, starts[:-1].tolist(), strict=True)))
+            corners.append(int(starts[-1]))
+        return cls(rows, at, corners)
+
+    @property
+    def nbytes(self) -> int:
+        return 8 * sum(self.corners)
+
+    def fill(self, block, table: TerminalTable, pool: MeshPool) -> None:
+        """Reserve each used set's block (``block(count, 2)`` of the file's builder) and write
+        its coordinates."""
+        for which, chosen in enumerate(self.rows):
+            if chosen:
+                start, data = block(self.corners[which], 2)
+                data[:] = corner_uvs(table, np.asarray(chosen), pool, which)
+                self.blocks.append((start, data))
+            else:
+                self.blocks.append((0, np.zeros((0, 2), np.float32)))
+
+    def attributes(self, row: int, count: int, accessor) -> dict[str, int]:
+        """TEXCOORD_0 / TEXCOORD_1 of a primitive whose rows start at ``row`` and that has
+        ``count`` corners (a textured material's rows are consecutive), as ``accessor(start,
+        data)`` of the file's builder makes them."""
+        out: dict[str, int] = {}
+        for which in (0, 1):
+            first = self.at[which].get(row)
+            if first is not None:
+                start, data = self.blocks[which]
+                out[f"TEXCOORD_{which}"] = accessor(start + first * 8, data[first : first + count])
+        return out
