@@ -2,9 +2,10 @@
 
 The rasterisers say which triangle each pixel sees (``Frame.triangle``); that is all texturing
 needs.  For every pixel on a textured triangle, the ray through the pixel's centre is cut with
-the triangle's plane (Moller-Trumbore, in bulk: one numpy expression over all such pixels), which
-gives the point's barycentric coordinates on the triangle in the world, hence its texture
-coordinates *perspective-correct* by construction (no interpolation in screen space).  The image
+the triangle's plane (Moller-Trumbore, its vectors once per triangle, then three affine
+functions of the pixel and two divisions per pixel, numpy in bulk), which gives the point's
+barycentric coordinates on the triangle in the world, hence its texture coordinates
+*perspective-correct* by construction (no interpolation in screen space).  The image
 is sampled there in linear light, coordinates outside 0..1 wrapped as the texture says (REPEAT by
 default, as glTF samplers and CGA do):
 
@@ -35,59 +36,66 @@ _LINEAR = np.where(
 )
 
 
-def _rays(frame: Frame, row: np.ndarray, col: np.ndarray) -> np.ndarray:
-    """(N, 3) world directions of the rays through the centres of pixels (row, col)."""
+def _coefficients(frame: Frame, scene: Scene, tris: np.ndarray) -> np.ndarray:
+    """(U, 3, 3) per triangle of ``tris``: the Moller-Trumbore determinant and the numerators of
+    the barycentric s and t as affine functions of the pixel, ``c[k] @ (1, column, row)``.
+
+    The ray through pixel (column, row) has the world direction ``D = D0 + column Dx + row Dy``
+    and starts at the camera, ``T = eye - a`` from the triangle's first corner, so with edges
+    e1, e2: det = D . (e2 x e1), s det = D . (e2 x T), t det = D . (T x e1), each a dot product
+    with a vector of the triangle alone: per pixel, three affine functions and two divisions."""
     camera = frame.camera
-    cx, cy = camera.center
-    f = camera.focal
-    ray = np.empty((len(row), 3))
-    ray[:, 0] = (col + 0.5 - cx) / f
-    ray[:, 1] = -(row + 0.5 - cy) / f
-    ray[:, 2] = -1.0
-    return ray @ camera.rotation  # camera -> world: the rotation's transpose, on row vectors
-
-
-def _plane_uv(frame: Frame, scene: Scene, ray: np.ndarray, tri: np.ndarray, clamp: bool):
-    """(N, 2) texture coordinates where each ray from the camera meets triangle ``tri``'s plane:
-    barycentric (1 - s - t, s, t), clamped into the triangle when ``clamp`` (a pixel centre on
-    an edge, or a triangle seen edge-on, must not reach past its corners into a neighbour's part
-    of an atlas); NaN where a ray runs along the plane (unclamped)."""
-    corners = scene.triangles[tri]
+    corners = scene.triangles[tris]
     a = corners[:, 0]
     e1, e2 = corners[:, 1] - a, corners[:, 2] - a
-    to_eye = frame.camera.position - a
-    p = np.cross(ray, e2)
-    q = np.cross(to_eye, e1)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        det = np.einsum("ij,ij->i", e1, p)
-        s = np.einsum("ij,ij->i", to_eye, p) / det
-        t = np.einsum("ij,ij->i", ray, q) / det
-    if clamp:
-        bad = ~(np.isfinite(s) & np.isfinite(t))
-        s[bad], t[bad] = 1.0 / 3.0, 1.0 / 3.0
-        s, t = np.clip(s, 0.0, 1.0), np.clip(t, 0.0, 1.0)
-        over = s + t > 1.0
-        total = s[over] + t[over]
-        s[over], t[over] = s[over] / total, t[over] / total
-    uv = scene.uv[tri]  # type: ignore[index]
-    return uv[:, 0] * (1.0 - s - t)[:, None] + uv[:, 1] * s[:, None] + uv[:, 2] * t[:, None]
+    to_eye = camera.position - a
+    cx, cy = camera.center
+    f = camera.focal
+    rot = camera.rotation  # world -> camera; its rows are the camera's axes in the world
+    along = np.stack(
+        [np.array([(0.5 - cx) / f, -(0.5 - cy) / f, -1.0]) @ rot, rot[0] / f, -rot[1] / f]
+    )
+    vectors = np.stack([np.cross(e2, e1), np.cross(e2, to_eye), np.cross(to_eye, e1)], axis=1)
+    return vectors @ along.T
 
 
-def pixel_uv(frame: Frame, scene: Scene, pixels: np.ndarray, tri: np.ndarray) -> np.ndarray:
-    """(N, 2) texture coordinates seen at the flat ``pixels`` (indices into the H x W image),
-    each on scene triangle ``tri``."""
+def pixel_uv(
+    frame: Frame, scene: Scene, pixels: np.ndarray, tri: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
+    """((N, 2) texture coordinates, (N, 2, 2) their change per pixel) seen at the flat
+    ``pixels`` (indices into the H x W image), each on scene triangle ``tri``.
+
+    The ray through the pixel's centre meets the triangle's plane at barycentric
+    (1 - s - t, s, t), clamped into the triangle (a pixel centre on an edge, or a triangle seen
+    edge-on, must not reach past its corners into a neighbour's part of an atlas).  The change
+    is to the rays through the right and lower neighbours, on the same plane, unclamped:
+    ``[[du, dv] per column, [du, dv] per row]``."""
     row, col = np.divmod(pixels, frame.camera.size[0])
-    return _plane_uv(frame, scene, _rays(frame, row, col), tri, clamp=True)
+    tris, index = np.unique(tri, return_inverse=True)
+    c = _coefficients(frame, scene, tris)[index.reshape(-1)]  # (N, 3, 3)
+    here = c[:, :, 0] + c[:, :, 1] * col[:, None] + c[:, :, 2] * row[:, None]  # (N, 3)
+    corner_uv = scene.uv[tri]  # type: ignore[index]
 
+    def at(value: np.ndarray, clamp: bool) -> np.ndarray:
+        with np.errstate(divide="ignore", invalid="ignore"):
+            s, t = value[:, 1] / value[:, 0], value[:, 2] / value[:, 0]
+        if clamp:
+            bad = ~(np.isfinite(s) & np.isfinite(t))
+            s[bad], t[bad] = 1.0 / 3.0, 1.0 / 3.0
+            s, t = np.clip(s, 0.0, 1.0), np.clip(t, 0.0, 1.0)
+            over = s + t > 1.0
+            total = s[over] + t[over]
+            s[over], t[over] = s[over] / total, t[over] / total
+        return (
+            corner_uv[:, 0] * (1.0 - s - t)[:, None]
+            + corner_uv[:, 1] * s[:, None]
+            + corner_uv[:, 2] * t[:, None]
+        )
 
-def pixel_footprint(frame: Frame, scene: Scene, pixels: np.ndarray, tri: np.ndarray):
-    """(N, 2, 2) how the texture coordinates change from each pixel to its right and lower
-    neighbours ([[du, dv] per column, [du, dv] per row]), on the pixel's triangle's plane."""
-    row, col = np.divmod(pixels, frame.camera.size[0])
-    here = _plane_uv(frame, scene, _rays(frame, row, col), tri, clamp=False)
-    right = _plane_uv(frame, scene, _rays(frame, row, col + 1), tri, clamp=False)
-    down = _plane_uv(frame, scene, _rays(frame, row + 1, col), tri, clamp=False)
-    return np.stack([right - here, down - here], axis=1)
+    uv = at(here, clamp=True)
+    centre = at(here, clamp=False)
+    step = np.stack([at(here + c[:, :, 1], False) - centre, at(here + c[:, :, 2], False) - centre])
+    return uv, step.transpose(1, 0, 2)
 
 
 def _wrap(index: np.ndarray, n: int, wrap: str) -> np.ndarray:
@@ -144,7 +152,7 @@ def sample(
 ) -> np.ndarray:
     """(N, 3) linear-light colours of a :class:`~.textured.Texture` at texture coordinates
     ``uv`` (N, 2), v up (row 0 of the image is v = 1).  ``footprint`` (N, 2, 2), from
-    :func:`pixel_footprint`, picks each pixel's mipmap level for ``bilinear``."""
+    :func:`pixel_uv`, picks each pixel's mipmap level for ``bilinear``."""
     rgb = texture.rgb
     h, w = rgb.shape[:2]
     if filter == "nearest":
@@ -188,8 +196,7 @@ def textured_pixels(
     if not len(pixels):
         return empty
     tri = flat[pixels].astype(np.int64)
-    uv = pixel_uv(frame, scene, pixels, tri)
-    footprint = pixel_footprint(frame, scene, pixels, tri) if filter == "bilinear" else None
+    uv, footprint = pixel_uv(frame, scene, pixels, tri)
     colour = np.empty((len(pixels), 3))
     order = np.argsort(which, kind="stable")
     cuts = np.flatnonzero(np.diff(which[order])) + 1
@@ -198,6 +205,6 @@ def textured_pixels(
             scene.textures[int(which[group[0]])],
             uv[group],
             filter,
-            None if footprint is None else footprint[group],
+            footprint[group],
         )
     return pixels, colour
