@@ -315,6 +315,51 @@ def test_obj_with_map_kd_renders_its_image(tmp_path):
         assert np.allclose(seen, linear(QUADRANTS[name]) * intensity.mean(), atol=0.01), name
 
 
+def test_gl_and_numpy_draw_the_same_textures(grammars, face):
+    gl_or_skip()
+    scene = load_scene(grammars[0])
+    camera = face.camera(-4, 0.7, 3)
+    gl = images.shaded(rasterise(scene, camera, "gl"), scene)
+    cpu = images.shaded(rasterise(scene, camera, "numpy"), scene)
+    assert (np.abs(gl.astype(int) - cpu.astype(int)).max(axis=2) <= 1).mean() > 0.999
+
+
+# --- CityGML ---------------------------------------------------------------------------------
+
+
+def test_citygml_wall_shows_its_image_in_a_y_up_frame(tmp_path):
+    """test_textured_read's wall (4 m x 3 m in the plane y = 0 of EPSG:6677, z up, u = x / 4)
+    beside a 4 x 2 image, left half red, right half blue: drawn y up about its centre, the
+    wall seen from +y (north) shows the red half on the right (x grows to the viewer's left)."""
+    from test_textured_read import WALL
+
+    (tmp_path / "tex").mkdir()
+    pixels = np.zeros((2, 4, 3), dtype=np.uint8)
+    pixels[:, :2], pixels[:, 2:] = (230, 30, 30), (40, 60, 220)
+    Image.fromarray(pixels).save(tmp_path / "tex" / "wall.png")
+    path = tmp_path / "wall.gml"
+    path.write_text(WALL.format(hole="", hole_uv="", image="tex/wall.png"), encoding="utf-8")
+    scene = load_scene(path)
+    assert scene.textured() and set(scene.labels) == {"WallSurface", "RoofSurface"}
+    # x 0..4 -> east -2..2; z 0..3 -> up; y -2..0 -> -north -1..1 (centred on the box)
+    lo, hi = scene.bounds()
+    np.testing.assert_allclose(lo, [-2, 0, -1], atol=1e-12)
+    np.testing.assert_allclose(hi, [2, 3, 1], atol=1e-12)
+    wall = Face(np.array([2.0, 0, -1]), np.array([-4.0, 0, 0]), np.array([0, 3.0, 0]))
+    camera = wall.camera(0, 0, 6)  # on the +y (north, render -z) side of the wall
+    assert camera.position[2] < -1
+    shot = render(scene, view=camera, backend="numpy")
+    white = Scene(
+        scene.triangles, np.full_like(scene.colors, 255), scene.part, scene.label, scene.labels
+    )
+    box = wall.box(camera)
+    intensity = linear(region(render(white, view=camera, backend="numpy"), box, 0.1, 0.1, 0.9, 0.9))
+    left = linear(region(shot, box, 0.1, 0.2, 0.35, 0.8)).mean(axis=0)
+    right = linear(region(shot, box, 0.65, 0.2, 0.9, 0.8)).mean(axis=0)
+    assert np.allclose(left, linear((40, 60, 220)) * intensity.mean(), atol=0.01)
+    assert np.allclose(right, linear((230, 30, 30)) * intensity.mean(), atol=0.01)
+
+
 # --- CityGML: the PLATEAU buildings -------------------------------------------------------------
 
 
