@@ -157,10 +157,16 @@ def build_parser() -> argparse.ArgumentParser:
     render = commands.add_parser(
         "render",
         help="draw a grammar or a model into a PNG preview",
-        description="Derive FILE.bgr (or read a model: .glb, .gltf, .obj with its .mtl, .ply) "
-        "and draw it headless into a PNG: shaded, silhouette, lines or labels.",
+        description="Derive FILE.bgr (or read a model: .glb, .gltf, .obj with its .mtl, .ply, "
+        "a CityGML 2.0 .gml) and draw it headless into a PNG: shaded (with its textures), "
+        "silhouette, lines or labels.",
     )
-    render.add_argument("file", metavar="FILE.bgr|MODEL")
+    render.add_argument(
+        "file",
+        metavar="FILE.bgr|MODEL",
+        help="a grammar, or a model: .glb, .gltf, .obj (with its .mtl), .ply or CityGML 2.0 .gml "
+        "(textured models and grammars are drawn with their textures)",
+    )
     render.add_argument("-o", "--output", metavar="OUT.png", help="the PNG to write")
     render.add_argument(
         "--mode",

@@ -9,7 +9,9 @@ The pieces, one concern each: :mod:`.scene` turns a source into triangles with c
 and labels; :mod:`.camera` is the pinhole camera of Nishida et al. 2018 (section 4.2) with the
 ``front``/``iso``/``top`` views fitted to the model; :mod:`.raster_gl` (OpenGL through EGL,
 fast) and :mod:`.raster_numpy` (numpy, the fallback) make the depth and triangle-index buffers;
-:mod:`.images` turns them into the four modes.
+:mod:`.images` turns them into the four modes; :mod:`.texturing` draws the textures of a
+textured scene (:mod:`.textured`: a textured grammar, glTF, OBJ+MTL or CityGML model) in the
+shaded mode from the triangle buffer alone, so both rasterisers draw them alike.
 """
 
 from __future__ import annotations
@@ -162,7 +164,7 @@ def render(
 ) -> np.ndarray:
     """An image of ``source``: a ``bgr.Result``, a :class:`Scene`, a trimesh, or the path of a
     ``.bgr`` file (derived with ``seed``, ``attrs`` and ``lot``, as ``bgr.derive`` takes them) or
-    of a ``.glb``/``.gltf`` file.
+    of a ``.glb``/``.gltf``, ``.obj``, ``.ply`` or CityGML ``.gml`` file; textures are drawn.
 
     ``mode``: ``shaded`` (H, W, 3), ``silhouette`` (H, W; 255 on the model), ``lines`` (H, W;
     black lines on white) or ``labels`` (H, W, 3; see :func:`render_labels` for the legend).

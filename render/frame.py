@@ -2,7 +2,9 @@
 
 Both backends start from the same camera-space triangles and the same near and far distances
 (:func:`prepare`), so that their buffers agree pixel for pixel up to rounding: the numpy one
-clips at ``near`` itself, the GL one lets the GPU clip at the same plane.
+clips at ``near`` itself, the GL one lets the GPU clip at the same plane.  Textures need no
+more than these buffers (render/texturing.py: a pixel's triangle and the camera give its
+texture coordinates), so both rasterisers draw them alike.
 """
 
 from __future__ import annotations

@@ -42,18 +42,27 @@ def facing_normals(frame: Frame, scene: Scene) -> np.ndarray:
     return n @ cam.rotation.T
 
 
-def shaded(frame: Frame, scene: Scene, background=BACKGROUND) -> np.ndarray:
+def shaded(
+    frame: Frame, scene: Scene, background=BACKGROUND, filter: str = "bilinear"
+) -> np.ndarray:
     """(H, W, 3) uint8: each triangle's colour under one light from the camera's upper left
-    (Lambert, in linear light, plus an ambient term), on a light background."""
+    (Lambert, in linear light, plus an ambient term), on a light background.  A textured
+    triangle's pixels show its image sampled there (render/texturing.py, ``filter`` bilinear or
+    nearest) times its colour, under the same light."""
     light = LIGHT / np.linalg.norm(LIGHT)
     intensity = AMBIENT + (1.0 - AMBIENT) * np.clip(facing_normals(frame, scene) @ light, 0.0, 1.0)
-    colours = _linear_to_srgb8(
-        _srgb_to_linear(scene.colors.astype(np.float64)) * intensity[:, None]
-    )
+    lit = _srgb_to_linear(scene.colors.astype(np.float64)) * intensity[:, None]
     table = np.concatenate(
-        [colours, np.array([background], dtype=np.uint8)]
+        [_linear_to_srgb8(lit), np.array([background], dtype=np.uint8)]
     )  # index -1: background
-    return table[frame.triangle]
+    image = table[frame.triangle]
+    if scene.textured():
+        from .texturing import textured_pixels
+
+        pixels, texel = textured_pixels(frame, scene, filter)
+        tri = frame.triangle.reshape(-1)[pixels]
+        image.reshape(-1, 3)[pixels] = _linear_to_srgb8(texel * lit[tri])
+    return image
 
 
 def silhouette(frame: Frame) -> np.ndarray:

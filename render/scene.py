@@ -1,8 +1,11 @@
 """What the renderer draws: world triangles with a colour, a part and a label each.
 
 Every source (a derivation ``Result``, a ``.bgr`` file, a ``.glb``/``.gltf``/``.obj``/``.ply``
-file, a trimesh) is turned into one :class:`Scene` so that the rasterisers and the image modes
-never care where the triangles came from.
+or CityGML ``.gml`` file, a trimesh) is turned into one :class:`Scene` so that the rasterisers
+and the image modes never care where the triangles came from.  A textured source (a grammar's
+``texture()``, a glTF or OBJ material with an image, a CityGML file) also gives each triangle
+its image and texture coordinates (render/textured.py); a model with textures is read by the
+textured-model readers (formats/textured_model.py), one without by the readers below.
 
 * ``part`` says where a triangle came from: the row of its terminal in the derivation's terminal
   table (so a pixel's triangle leads to the terminal's path, rule and scope), or its material's
@@ -49,6 +52,18 @@ class Scene:
     # the direction the lots' fronts face (a unit world vector in the x-z plane, see
     # lots_front), which the front/iso/top views look at; None: bgr's default front, -z
     front: np.ndarray | None = None
+    # textures (render/textured.py, drawn by render/texturing.py): per triangle the index of its
+    # image in ``textures`` (-1: none, its colour alone) and its corners' texture coordinates,
+    # (0, 0) at the image's lower-left, v up; None: an untextured scene
+    texture: np.ndarray | None = None  # (T,) int64
+    uv: np.ndarray | None = None  # (T, 3, 2) float64
+    textures: list = field(default_factory=list)  # textured.Texture
+
+    def textured(self) -> bool:
+        """Whether any triangle shows an image."""
+        if self.texture is None or not self.textures:
+            return False
+        return bool((self.texture >= 0).any())
 
     def __len__(self) -> int:
         return len(self.triangles)
@@ -106,23 +121,38 @@ def lots_front(lots: list) -> np.ndarray | None:
     return np.array([mean[0] / length, 0.0, mean[1] / length])
 
 
-def _labels_index(names) -> tuple[np.ndarray, list[str]]:
+def labels_index(names) -> tuple[np.ndarray, list[str]]:
+    """(index of each name into the sorted distinct names, those names)."""
     labels, index = np.unique(
         np.asarray(list(names), dtype=object).astype(str), return_inverse=True
     )
     return index.reshape(-1).astype(np.int64), [str(s) for s in labels]
 
 
+_labels_index = labels_index
+
+
 def from_result(result: Any) -> Scene:
-    """A derivation's terminals: part = terminal row, label = terminal label."""
-    from ..formats.meshes import bake, srgb8
+    """A derivation's terminals: part = terminal row, label = terminal label; the colour maps
+    of textured terminals with their coordinates (render/textured.py)."""
+    from ..formats.meshes import MeshPool, bake, srgb8
 
     table = result.terminals if hasattr(result, "terminals") else result
     table.freeze()
-    baked = bake(table)
+    pool = MeshPool.of(table)
+    baked = bake(table, pool=pool)
     row = np.repeat(np.arange(len(table), dtype=np.int64), np.diff(baked.fstart))
     label_of_row, labels = _labels_index(table.label) if len(table) else (np.zeros(0, np.int64), [])
+    texture = uv = None
+    textures: list = []
+    if len(getattr(table, "tex_rows", ())):
+        from .textured import table_textures
+
+        texture, uv, textures = table_textures(table, pool, baked.fstart)
     return Scene(
+        texture=texture,
+        uv=uv,
+        textures=textures,
         triangles=baked.vertices[baked.faces],
         colors=srgb8(table)[row],
         part=row,
@@ -209,6 +239,28 @@ def _model_errors(shown: str, what: str, hint: str, caught: tuple = (Exception,)
         raise BgrError(Diagnostic(shown, 0, 0, message, hint)) from None
 
 
+def _gltf_textured(gltf: dict) -> bool:
+    """Whether a glTF file's materials show images (then its textured reader draws it)."""
+    materials = gltf.get("materials")
+    if not gltf.get("images") or not isinstance(materials, list):
+        return False
+    for mat in materials:
+        pbr = mat.get("pbrMetallicRoughness") if isinstance(mat, dict) else None
+        if isinstance(pbr, dict) and isinstance(pbr.get("baseColorTexture"), dict):
+            return True
+    return False
+
+
+def from_citygml(path: str | os.PathLike) -> Scene:
+    """A CityGML 2.0 file with its textures (formats/citygml_read.py), z up turned to y up in a
+    local metric frame (render/textured.py: a geographic CRS on a local transverse Mercator);
+    labels by semantic surface type."""
+    from ..formats.citygml_read import read_citygml
+    from .textured import from_textured_mesh
+
+    return from_textured_mesh(read_citygml(path), str(path))
+
+
 def from_gltf(path: str | os.PathLike) -> Scene:
     """A .glb or .gltf file, instances expanded (``read_glb``); parts and labels by material."""
     from ..formats.glb_read import load, scene_roots, world_mesh
@@ -221,6 +273,11 @@ def from_gltf(path: str | os.PathLike) -> Scene:
         (ValueError, KeyError, IndexError, TypeError, AttributeError, StopIteration),
     ):
         gltf, blob = load(path)
+        if _gltf_textured(gltf):
+            from ..formats.gltf_textured import read_gltf_textured
+            from .textured import from_textured_mesh
+
+            return from_textured_mesh(read_gltf_textured(path), shown)
         mesh = world_mesh(gltf, blob, scene_roots(gltf))
         names, material = _glb_materials(gltf, blob)
     return from_trimesh(mesh, names, material)
@@ -280,6 +337,11 @@ def _material_label(name: str | None) -> str:
     return name
 
 
+def _has_colour_map(mtl: bytes) -> bool:
+    """Whether a material library names a colour map (``map_Kd``) on some line."""
+    return any(line.strip().lower().startswith(b"map_kd") for line in mtl.splitlines())
+
+
 def from_mesh_file(path: str | os.PathLike) -> Scene:
     """A .obj (colours from the .mtl files it names, labels and parts by material) or a .ply
     (vertex or face colours, labels and parts by colour), read with trimesh."""
@@ -302,6 +364,11 @@ def from_mesh_file(path: str | os.PathLike) -> Scene:
         ):  # trimesh's parsers raise many kinds of exception
             data = read_input(path, "model file")
             libraries, warnings = _mtl_libraries(path, data) if fmt == "obj" else ({}, [])
+            if any(_has_colour_map(mtl) for mtl in libraries.values()):
+                from ..formats.obj_textured import read_obj_textured
+                from .textured import from_textured_mesh
+
+                return from_textured_mesh(read_obj_textured(path), shown)
             stream: io.IOBase = io.BytesIO(data)
             if fmt == "obj":  # a text file: bytes that are not text are no OBJ
                 if b"\0" in data:
@@ -362,8 +429,8 @@ def load_scene(
     """A :class:`Scene` from a Scene, a ``bgr.Result``, a terminal table, a trimesh, or a path to
     a ``.bgr`` (loaded with ``allow_paths`` as :func:`bgr.load`, derived with ``seed``,
     ``attrs``, ``lot`` and ``strict``, its warnings kept in ``Scene.warnings``), ``.glb``,
-    ``.gltf``, ``.obj`` or ``.ply`` file.  ``lot_options`` (a LotOptions: --front, --map) go to
-    the derivation."""
+    ``.gltf``, ``.obj``, ``.ply`` or CityGML 2.0 ``.gml`` file.  ``lot_options`` (a LotOptions:
+    --front, --map) go to the derivation."""
     if isinstance(source, Scene):
         return source
     if isinstance(source, (str, os.PathLike)):
@@ -401,13 +468,15 @@ def load_scene(
             return from_gltf(path)
         if suffix in (".obj", ".ply"):
             return from_mesh_file(path)
+        if suffix == ".gml":
+            return from_citygml(path)
         raise BgrError(
             Diagnostic(
                 str(source),
                 0,
                 0,
                 f"cannot render a '{suffix or 'extensionless'}' file",
-                "give a .bgr grammar or a .glb, .gltf, .obj or .ply model",
+                "give a .bgr grammar or a .glb, .gltf, .obj, .ply or CityGML .gml model",
             )
         )
     if hasattr(source, "terminals") or hasattr(source, "library"):
