@@ -538,7 +538,7 @@ class Checker:
     def texture_file(self, expr: n.String) -> None:
         """A literal texture path must name a readable PNG or JPEG within the grammar's roots
         (a computed one is checked when the derivation first uses it)."""
-        if not self.g.roots:  # a Grammar made by hand: its files are not checked
+        if not self.g.roots or expr.value == "":  # by hand: not checked; "": no map
             return
         try:
             load(self.g.path, self.g.roots, expr.value)

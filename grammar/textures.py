@@ -80,6 +80,12 @@ def read_image(path: Path, shown: str) -> Image:
     except (OSError, ValueError) as e:
         reason = getattr(e, "strerror", None) or str(e)
         raise TextureError(f"texture file '{shown[:200]}' cannot be read: {reason}") from None
+    return decode_image(data, str(path), shown)
+
+
+def decode_image(data: bytes, key: str, shown: str) -> Image:
+    """An :class:`Image` of PNG or JPEG bytes (``key``: what makes it distinct, a resolved path
+    or a path and a name inside a model file); :class:`TextureError` for anything else."""
     try:
         from PIL import Image as PILImage
 
@@ -98,7 +104,7 @@ def read_image(path: Path, shown: str) -> Image:
             f"texture file '{shown[:200]}' is a {kind or 'unknown'} image",
             "textures are PNG or JPEG files (what glTF readers take); convert it",
         )
-    return Image(str(path), data, MIME[kind], int(width), int(height), bool(alpha))
+    return Image(key, data, MIME[kind], int(width), int(height), bool(alpha))
 
 
 def load(module_path: str, roots: Iterable[Path], text: str) -> Image:
