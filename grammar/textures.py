@@ -48,11 +48,12 @@ def base_folder(module_path: str) -> Path:
     return Path(module_path).parent
 
 
-def locate(module_path: str, roots: Iterable[Path], text: str) -> Path:
-    """The file a texture path names, resolved; :class:`TextureError` when it is out of reach."""
+def locate(module_path: str, roots: Iterable[Path], text: str, folder: Path | None = None) -> Path:
+    """The file a texture path names, resolved (from ``folder``, the module's real folder, when
+    given); :class:`TextureError` when it is out of reach."""
     if not isinstance(text, str) or not text or "\0" in text:
         raise TextureError(f"{text!r} is not a texture file name", 'write texture("file.png")')
-    path = (base_folder(module_path) / text).resolve()
+    path = ((folder or base_folder(module_path)) / text).resolve()
     roots = tuple(roots)
     if roots and not within(path, roots):
         raise TextureError(
@@ -107,6 +108,6 @@ def decode_image(data: bytes, key: str, shown: str) -> Image:
     return Image(key, data, MIME[kind], int(width), int(height), bool(alpha))
 
 
-def load(module_path: str, roots: Iterable[Path], text: str) -> Image:
+def load(module_path: str, roots: Iterable[Path], text: str, folder: Path | None = None) -> Image:
     """:func:`locate` then :func:`read_image`."""
-    return read_image(locate(module_path, roots, text), text)
+    return read_image(locate(module_path, roots, text, folder), text)

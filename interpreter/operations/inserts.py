@@ -56,6 +56,7 @@ def _load_asset(app, step, module, asset):
     """Load an OBJ, GLB or PLY once per derivation; its unit mesh, bounding size and offset."""
     cache = app.engine.__dict__.setdefault("asset_cache", {})
     base = Path(module.path).parent if module.path not in ("<text>", "<stdin>") else Path.cwd()
+    base = module.folder or base  # the real folder: a stdlib module's path is only its name
     path = (base / asset.path).resolve()
     if path in cache:
         return cache[path]

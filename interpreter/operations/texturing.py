@@ -174,7 +174,7 @@ def _image(app, step, path) -> int:
     found = cache.get(key)
     if found is None:
         try:
-            image = load(app.module.path, app.module.roots, path)
+            image = load(app.module.path, app.module.roots, path, app.module.folder)
         except TextureError as e:
             raise runtime_error(app.module, step.pos, e.message, e.hint) from None
         found = cache[key] = engine.table.add_image(image)
