@@ -45,7 +45,7 @@ from .instancing import CORNER_BYTES, INSTANCE_BYTES, plan, quaternions
 from .materials import Materials, materials_of
 from .meshes import MeshPool, bounds, face_offsets, place_corners, unit_normals
 from .terminal_json import plain
-from .texcoords import corner_uvs, texture_keys
+from .texcoords import corner_tangents, corner_uvs, texture_keys
 
 INSTANCING = "EXT_mesh_gpu_instancing"
 FLOAT, ARRAY_BUFFER = 5126, 34962
@@ -348,7 +348,7 @@ class Scene:
         has_normal = {k for k, t in enumerate(textured) if t[1] is not None}
         normal_rows = [r for r in uv_rows if int(mats.index[r]) in has_normal]
         n_nuv = 3 * int(face_offsets(table, np.asarray(normal_rows, np.int64), pool)[-1])
-        nbytes += (n_uv + n_nuv) * 8
+        nbytes += (n_uv + n_nuv) * 8 + n_nuv * 16  # and a TANGENT per normal-mapped corner
         for mesh_id, _, rows in p.groups:
             nbytes += int(pool.fcount[mesh_id]) * 3 * CORNER_BYTES + len(rows) * INSTANCE_BYTES
         b = _Builder(nbytes, (sp["bin"].nbytes, sp["views"].count, sp["accessors"].count))
@@ -372,6 +372,7 @@ class Scene:
                 at += 3 * int(pool.fcount[table.mesh[r]])
             nuv_off, nuv_data = b.block(n_nuv, 2)
             nuv_data[:] = corner_uvs(table, np.asarray(normal_rows), pool, 1)
+            tan_off, tan_data = b.block(n_nuv, 4)  # filled once the corners are placed
 
         # baked terminals: one primitive per (group, material), a slice of two big blocks
         prims: list[list[dict]] = [[] for _ in groups.name]
@@ -386,6 +387,14 @@ class Scene:
                 nrm_data.reshape(-1, 3, 3),
                 self.shift,
             )
+            if normal_rows:  # tangents of the normal-mapped corners, from their placed triangles
+                at_row = np.empty(len(table), dtype=np.int64)
+                at_row[p.baked] = np.arange(len(p.baked))
+                nr = np.asarray(normal_rows, dtype=np.int64)
+                count = 3 * pool.fcount[table.mesh[nr]]
+                corner = np.repeat(3 * fstart[at_row[nr]] - np.cumsum(count) + count, count)
+                corner += np.arange(int(count.sum()))
+                tan_data[:] = corner_tangents(pos_data[corner], nrm_data[corner], nuv_data)
             key = major[p.baked]
             cuts = np.flatnonzero(np.diff(key)) + 1
             for lo, hi in zip(
@@ -409,6 +418,9 @@ class Scene:
                         u1 = nuv_at[int(row)]
                         attributes["TEXCOORD_1"] = b.accessor(
                             nuv_off + u1 * 8, nuv_data[u1 : u1 + end - first]
+                        )
+                        attributes["TANGENT"] = b.accessor(
+                            tan_off + u1 * 16, tan_data[u1 : u1 + end - first]
                         )
                     prims[int(groups.of_row[row])].append(
                         {"attributes": attributes, "material": int(mats.index[row]), "mode": 4}
