@@ -38,6 +38,7 @@ EXAMPLES = [
     ("l_building.bgr", "l_lot.geojson", 1, (35.0, 30.0)),  # from behind: the L's inner corner
     ("city_block.bgr", None, 2, "iso"),
     ("stdlib_street.bgr", "block.geojson", 5, "iso"),
+    ("textured_house.bgr", None, 3, "iso"),
 ]
 
 # How a thumbnail shows each module's rules: a wrapper rule applying lib.NAME, and the view.
@@ -58,6 +59,17 @@ WRAPPERS = {
     ),
 }
 ENTRANCE = "Lot --> s(2.2, 0, 1) extrude(3) comp(f) {{ front: lib.{name} | all: NIL }}"
+# stdlib.textured: a wall with the projection its surface rules expect; its roofs on a top face,
+# its window in an opening
+WRAPPERS["textured"] = (
+    "Lot --> s(8, 0, 1) extrude(6) comp(f) {{ front: setupProjection(0, scope.xy, ~2, ~1.2) "
+    "lib.{name} | all: NIL }}",
+    "front",
+)
+TEXTURED = {
+    "Gable": ("Lot --> s(10, 0, 8) extrude(5) comp(f) {{ top: lib.{name} | all: NIL }}", "iso"),
+    "Glazed": (WRAPPERS["window"][0], "front"),
+}
 
 
 def quantised(image: np.ndarray) -> np.ndarray:
@@ -134,6 +146,8 @@ def retargeted() -> None:
 
 def thumbnail(module: str, rule: str) -> np.ndarray:
     template, view = WRAPPERS[module]
+    if module == "textured" and rule in TEXTURED:
+        template, view = TEXTURED[rule]
     if module == "window" and rule.endswith("Entrance"):
         template = ENTRANCE
     if template is None:  # a mass takes the lot itself

@@ -305,6 +305,7 @@ class Scene:
                 nrm_data.reshape(-1, 3, 3),
                 self.shift,
             )
+            uvs.tangents(table, p.baked, fstart, pos_data, nrm_data, pool)
             key = major[p.baked]
             cuts = np.flatnonzero(np.diff(key)) + 1
             for lo, hi in zip(

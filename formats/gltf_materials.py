@@ -20,7 +20,7 @@ from bgr.interpreter.terminals import TerminalTable
 
 from .materials import Materials, materials_of
 from .meshes import MeshPool, face_offsets
-from .texcoords import corner_uvs
+from .texcoords import corner_tangents, corner_uvs
 
 LINEAR, REPEAT = 9729, 10497
 
@@ -171,7 +171,8 @@ class UvSets:
 
     @property
     def nbytes(self) -> int:
-        return 8 * sum(self.corners)
+        # and a TANGENT per normal-mapped corner
+        return 8 * sum(self.corners) + 16 * self.corners[1]
 
     def fill(self, block, table: TerminalTable, pool: MeshPool) -> None:
         """Reserve each used set's block (``block(count, 2)`` of the file's builder) and write
@@ -183,6 +184,22 @@ class UvSets:
                 self.blocks.append((start, data))
             else:
                 self.blocks.append((0, np.zeros((0, 2), np.float32)))
+        if self.rows[1]:  # filled by tangents() once the corners are placed
+            self.blocks.append(block(self.corners[1], 4))
+
+    def tangents(self, table, baked, fstart, positions, normals, pool: MeshPool) -> None:
+        """The TANGENT of every normal-mapped corner, from its placed triangle (``positions``
+        and ``normals``: the part's baked corners, whose rows ``baked`` start at ``fstart``)."""
+        if not self.rows[1]:
+            return
+        at_row = np.empty(len(table), dtype=np.int64)
+        at_row[baked] = np.arange(len(baked))
+        nr = np.asarray(self.rows[1], dtype=np.int64)
+        count = 3 * pool.fcount[table.mesh[nr]]
+        corner = np.repeat(3 * fstart[at_row[nr]] - np.cumsum(count) + count, count)
+        corner += np.arange(int(count.sum()))
+        uv1 = self.blocks[1][1]
+        self.blocks[2][1][:] = corner_tangents(positions[corner], normals[corner], uv1)
 
     def attributes(self, row: int, count: int, accessor) -> dict[str, int]:
         """TEXCOORD_0 / TEXCOORD_1 of a primitive whose rows start at ``row`` and that has
@@ -194,4 +211,7 @@ class UvSets:
             if first is not None:
                 start, data = self.blocks[which]
                 out[f"TEXCOORD_{which}"] = accessor(start + first * 8, data[first : first + count])
+                if which == 1:
+                    start, data = self.blocks[2]
+                    out["TANGENT"] = accessor(start + first * 16, data[first : first + count])
         return out

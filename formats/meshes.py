@@ -30,6 +30,9 @@ class MeshPool:
     vcount: np.ndarray
     foff: np.ndarray
     fcount: np.ndarray
+    # per-corner texture coordinates of the meshes that have their own (inserted assets),
+    # uv[foff[m]:foff[m] + fcount[m]] (zeros for the others); None when no mesh has any
+    uv: np.ndarray | None = None
 
     @classmethod
     def of(cls, table: TerminalTable) -> MeshPool:
@@ -38,6 +41,11 @@ class MeshPool:
         faces = [m.faces for m in meshes] or [np.zeros((0, 3), dtype=np.int64)]
         vcount = np.fromiter(map(len, verts), dtype=np.int64, count=len(verts))[: len(meshes)]
         fcount = np.fromiter(map(len, faces), dtype=np.int64, count=len(faces))[: len(meshes)]
+        uv = None
+        if any(m.uv is not None for m in meshes):
+            uv = np.concatenate(
+                [m.uv if m.uv is not None else np.zeros((len(m.faces), 3, 2)) for m in meshes]
+            )
         return cls(
             vertices=np.concatenate(verts).astype(np.float64, copy=False),
             faces=np.concatenate(faces).astype(np.int64, copy=False),
@@ -45,6 +53,7 @@ class MeshPool:
             vcount=vcount,
             foff=np.concatenate([[0], np.cumsum(fcount)[:-1]]).astype(np.int64),
             fcount=fcount,
+            uv=uv,
         )
 
     def flat_at_zero(self) -> np.ndarray:

@@ -2,9 +2,10 @@
 :func:`meshes.bake` (OBJ, CityJSON) gives their corners.
 
 A terminal's coordinates are an affine map of its unit-scope vertices (the terminal table's
-``tex_uv``), so every corner's uv is one matrix product per unit mesh, numpy in bulk.  glTF puts
-v = 0 at the top of the image, CGA at the bottom: glTF files store 1 - v (:func:`corner_uvs`);
-OBJ and CityJSON put v = 0 at the bottom as CGA does (:func:`baked_uvs`).
+``tex_uv``), so every corner's uv is one matrix product per unit mesh, numpy in bulk; an
+inserted asset that shows its own texture (``tex_own``) takes its unit mesh's per-corner uvs
+instead.  glTF puts v = 0 at the top of the image, CGA at the bottom: glTF files store 1 - v
+(:func:`corner_uvs`); OBJ and CityJSON put v = 0 at the bottom as CGA does (:func:`baked_uvs`).
 """
 
 from __future__ import annotations
@@ -33,6 +34,9 @@ def cga_corner_uvs(
     slot = np.full(len(table), -1, dtype=np.int64)
     slot[np.asarray(table.tex_rows, dtype=np.int64)] = np.arange(len(table.tex_rows))
     maps = np.asarray(table.tex_uv)[slot[rows], which]  # (n, 2, 4)
+    own = np.asarray(table.tex_own, dtype=bool).reshape(-1)
+    # the colour map of an inserted asset that keeps its own coordinates (its unit mesh's)
+    own = own[slot[rows]] if which == 0 and len(own) else np.zeros(len(rows), dtype=bool)
     mesh = table.mesh[rows].astype(np.int64)
     fcount = pool.fcount[mesh].astype(np.int64)
     start = np.concatenate([[0], np.cumsum(fcount)])
@@ -47,6 +51,8 @@ def cga_corner_uvs(
         unit = pool.vertices[pool.faces[lo : lo + F].reshape(-1) + pool.voff[m]]  # (3F, 3)
         uv = np.einsum("nij,vj->nvi", maps[sel, :, :3], unit) + maps[sel, None, :, 3]
         tri = uv.reshape(len(sel), F, 3, 2)
+        if pool.uv is not None and own[sel].any():
+            tri[own[sel]] = pool.uv[lo : lo + F]
         tri[flip[sel]] = tri[flip[sel]][:, :, [0, 2, 1]]  # re-wound as place_corners does
         at = (start[sel][:, None] + np.arange(F)).reshape(-1)
         out[at] = tri.reshape(-1, 3, 2)
@@ -80,3 +86,36 @@ def baked_uvs(table: TerminalTable, rows: np.ndarray, pool: MeshPool) -> np.ndar
         )
         out[at] = uv
     return out
+
+
+def corner_tangents(positions: np.ndarray, normals: np.ndarray, uv: np.ndarray) -> np.ndarray:
+    """(T * 3, 4) float32 glTF TANGENTs of flat triangles for a normal map: xyz the direction in
+    which u grows (made perpendicular to the face normal), w the sign that makes
+    cross(normal, tangent) * w point the way the image's up (v) grows, so the map's +Y is up as
+    glTF's normal textures have it.  ``positions`` and ``normals`` (T * 3, 3), ``uv`` (T * 3, 2)
+    in glTF's v-down convention, all in corner order.  A triangle whose uvs have no area gets a
+    tangent along its first edge."""
+    p = np.asarray(positions, dtype=np.float64).reshape(-1, 3, 3)
+    n = np.asarray(normals, dtype=np.float64).reshape(-1, 3, 3)[:, 0]
+    t = np.asarray(uv, dtype=np.float64).reshape(-1, 3, 2) * [1.0, -1.0]  # v up again
+    e1, e2 = p[:, 1] - p[:, 0], p[:, 2] - p[:, 0]
+    d1, d2 = t[:, 1] - t[:, 0], t[:, 2] - t[:, 0]
+    det = d1[:, 0] * d2[:, 1] - d2[:, 0] * d1[:, 1]
+    ok = np.abs(det) > 1e-20
+    r = np.where(ok, 1.0 / np.where(ok, det, 1.0), 0.0)[:, None]
+    tan = (e1 * d2[:, 1:2] - e2 * d1[:, 1:2]) * r
+    bit = (e2 * d1[:, 0:1] - e1 * d2[:, 0:1]) * r
+    tan = np.where(ok[:, None], tan, e1)
+    tan -= n * np.einsum("ij,ij->i", n, tan)[:, None]  # into the face's plane
+    length = np.sqrt(np.einsum("ij,ij->i", tan, tan))
+    flat = ~(length > 1e-12)
+    if flat.any():  # no direction in the plane: any unit vector perpendicular to the normal
+        other = np.where(np.abs(n[flat, 0:1]) < 0.9, [[1.0, 0.0, 0.0]], [[0.0, 1.0, 0.0]])
+        tan[flat] = np.cross(n[flat], other)
+        length[flat] = np.sqrt(np.einsum("ij,ij->i", tan[flat], tan[flat]))
+    tan /= np.where(length > 0, length, 1.0)[:, None]
+    w = np.where(np.einsum("ij,ij->i", np.cross(n, tan), bit) < 0.0, -1.0, 1.0)
+    out = np.empty((len(p), 3, 4), dtype=np.float32)
+    out[:, :, :3] = tan[:, None, :]
+    out[:, :, 3] = w[:, None]
+    return out.reshape(-1, 4)

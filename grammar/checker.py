@@ -88,6 +88,9 @@ class Grammar:
     # the folders its imports and assets may resolve in (grammar/paths.py), set by bgr.load;
     # empty (a Grammar made by hand) leaves its assets unchecked
     roots: tuple[Path, ...] = ()
+    # the real folder of its file, where its relative texture and asset paths start (``path`` is
+    # what messages show: stdlib/NAME.bgr for a stdlib module); None: the folder of ``path``
+    folder: Path | None = None
     # levels of each func's body, the bodies of the funcs it calls included (grammar.limits)
     func_depths: dict[str, int] = field(default_factory=dict)
     recursive_funcs: set[str] = field(default_factory=set)  # funcs that call themselves
@@ -538,10 +541,10 @@ class Checker:
     def texture_file(self, expr: n.String) -> None:
         """A literal texture path must name a readable PNG or JPEG within the grammar's roots
         (a computed one is checked when the derivation first uses it)."""
-        if not self.g.roots:  # a Grammar made by hand: its files are not checked
+        if not self.g.roots or expr.value == "":  # by hand: not checked; "": no map
             return
         try:
-            load(self.g.path, self.g.roots, expr.value)
+            load(self.g.path, self.g.roots, expr.value, self.g.folder)
         except TextureError as e:
             self.error(expr.pos, e.message, e.hint)
 

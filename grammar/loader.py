@@ -101,8 +101,8 @@ class Loader:
         except BgrError as e:
             self.diagnostics += e.diagnostics
             return None
-        grammar = Grammar(path, module, roots=self.roots)
         folder = Path(key).parent if key else Path.cwd()
+        grammar = Grammar(path, module, roots=self.roots, folder=folder)
         broken: dict[str, bool] = {}
         for item in module.items:
             if isinstance(item, n.Import):

@@ -285,7 +285,8 @@ OPERATIONS: dict[str, Op] = {
             "texturing",
             _sig(Param("path", STRING)),
             "Set the colour map (uv-set 0): a PNG or JPEG file, found like assets (the grammar's "
-            "folder, the stdlib, --allow-path); its alpha channel is the opacity.",
+            "folder, the stdlib, --allow-path); its alpha channel is the opacity. "
+            '`texture("")` removes it, so that an inserted asset shows its own texture.',
             'texture("bricks.png")',
         ),
         Op(

@@ -15,13 +15,14 @@ from .loader import _stdlib_dir
 from .parser import parse
 
 # The modules in the order the reference shows them, with how thumbnails are made.
-MODULES = ("mass", "facade", "window", "roof", "palette")
+MODULES = ("mass", "facade", "window", "roof", "palette", "textured")
 TITLES = {
     "mass": "Building masses (`stdlib.mass`)",
     "facade": "Façades (`stdlib.facade`)",
     "window": "Windows and entrances (`stdlib.window`)",
     "roof": "Roof assemblies (`stdlib.roof`)",
     "palette": "Colours (`stdlib.palette`)",
+    "textured": "Textured surfaces (`stdlib.textured`)",
 }
 
 EXAMPLE = """\
@@ -79,7 +80,7 @@ def stdlib_markdown(example: dict[str, str] | None = None) -> str:
         "parameters: plug in your own rule anywhere a stdlib part goes. The families follow",
         "Nishida et al. 2018 (*Procedural modeling of a building from a single image*): 30 masses",
         "(Figure 3), 16 façades (Figure 5) and 31 windows and entrances (Figure 6), plus roof",
-        "assemblies and a colour palette.",
+        "assemblies, a colour palette and textured surfaces (the images bgr ships).",
         "",
         "A building from the library in a few lines:",
         "",
@@ -93,7 +94,9 @@ def stdlib_markdown(example: dict[str, str] | None = None) -> str:
         " `front` to the street face, `roof` to the top;",
         "- **façades** receive a vertical face from `comp(f)` and split it into floors and tiles;",
         "- **windows and entrances** receive the opening rectangle a façade leaves for them;",
-        "- **roof assemblies** receive the top face of a mass.",
+        "- **roof assemblies** receive the top face of a mass;",
+        "- **textured surfaces** receive a face whose caller set up a projection"
+        " (`setupProjection(0, scope.xy, ~2, ~1.2)`).",
         "",
         "![contact sheet of the standard library](img/stdlib/contact_sheet.png)",
         "",

@@ -48,11 +48,12 @@ def base_folder(module_path: str) -> Path:
     return Path(module_path).parent
 
 
-def locate(module_path: str, roots: Iterable[Path], text: str) -> Path:
-    """The file a texture path names, resolved; :class:`TextureError` when it is out of reach."""
+def locate(module_path: str, roots: Iterable[Path], text: str, folder: Path | None = None) -> Path:
+    """The file a texture path names, resolved (from ``folder``, the module's real folder, when
+    given); :class:`TextureError` when it is out of reach."""
     if not isinstance(text, str) or not text or "\0" in text:
         raise TextureError(f"{text!r} is not a texture file name", 'write texture("file.png")')
-    path = (base_folder(module_path) / text).resolve()
+    path = ((folder or base_folder(module_path)) / text).resolve()
     roots = tuple(roots)
     if roots and not within(path, roots):
         raise TextureError(
@@ -80,6 +81,12 @@ def read_image(path: Path, shown: str) -> Image:
     except (OSError, ValueError) as e:
         reason = getattr(e, "strerror", None) or str(e)
         raise TextureError(f"texture file '{shown[:200]}' cannot be read: {reason}") from None
+    return decode_image(data, str(path), shown)
+
+
+def decode_image(data: bytes, key: str, shown: str) -> Image:
+    """An :class:`Image` of PNG or JPEG bytes (``key``: what makes it distinct, a resolved path
+    or a path and a name inside a model file); :class:`TextureError` for anything else."""
     try:
         from PIL import Image as PILImage
 
@@ -98,9 +105,9 @@ def read_image(path: Path, shown: str) -> Image:
             f"texture file '{shown[:200]}' is a {kind or 'unknown'} image",
             "textures are PNG or JPEG files (what glTF readers take); convert it",
         )
-    return Image(str(path), data, MIME[kind], int(width), int(height), bool(alpha))
+    return Image(key, data, MIME[kind], int(width), int(height), bool(alpha))
 
 
-def load(module_path: str, roots: Iterable[Path], text: str) -> Image:
+def load(module_path: str, roots: Iterable[Path], text: str, folder: Path | None = None) -> Image:
     """:func:`locate` then :func:`read_image`."""
-    return read_image(locate(module_path, roots, text), text)
+    return read_image(locate(module_path, roots, text, folder), text)

@@ -121,6 +121,7 @@ class Engine:
             self.memory_base = now if memory_base is None else memory_base
             self.memory_full_at = (max_memory - (now - self.memory_base)) / BYTES_PER_SHAPE
         self._mesh_triangles: list[int] = []  # triangles per library mesh id
+        self._mesh_images: list[int] = []  # per library mesh id: its own image's index, or -1
         self.compilers: dict[int, Compiler] = {}
         self.attrs = self._prepare_values(grammar, dict(attrs or {}))
         self.table = TerminalTable()
@@ -298,13 +299,17 @@ class Engine:
         t.size.append(shape.size)
         t.color.append(shape.color)
         t.material.append(shape.material)
-        if shape.tex is not None:
-            t.add_texturing(len(t.label) - 1, shape.tex)
         mesh = self.mesh_id(shape.geom)
         t.mesh.append(mesh)
-        counts = self._mesh_triangles
+        counts, own = self._mesh_triangles, self._mesh_images
         while len(counts) < len(t.library.meshes):
-            counts.append(len(t.library.meshes[len(counts)].faces))
+            unit = t.library.meshes[len(counts)]
+            counts.append(len(unit.faces))
+            # an inserted asset's own texture: its image in the table, once per unit mesh
+            textured = unit.image is not None and unit.uv is not None
+            own.append(t.add_image(unit.image) if textured else -1)
+        if shape.tex is not None or own[mesh] >= 0:
+            t.add_texturing(len(t.label) - 1, shape.tex, own[mesh])
         self.triangles += counts[mesh]
         if self.triangles > self.max_triangles:
             raise runtime_error(

@@ -17,15 +17,24 @@ import numpy as np
 
 @dataclass
 class UnitMesh:
-    """Triangles in unit scope coordinates.  ``name`` is what the JSON's ``geometry`` says."""
+    """Triangles in unit scope coordinates.  ``name`` is what the JSON's ``geometry`` says.
+
+    An inserted asset with a texture of its own keeps it here: ``uv`` its texture coordinates
+    per triangle corner (v up, as CGA has them) and ``image`` the picture
+    (grammar.textures.Image); a terminal whose shape sets no colour map of its own shows them
+    (TerminalTable.tex_own)."""
 
     name: str
     vertices: np.ndarray  # (V, 3) float64, in [0, 1] per scope axis
     faces: np.ndarray  # (F, 3) int32, counter-clockwise seen from outside
+    uv: np.ndarray | None = None  # (F, 3, 2) float64, per corner; None: no coordinates
+    image: Any = None  # grammar.textures.Image of the asset's colour map, or None
 
     def __post_init__(self) -> None:
         self.vertices = np.ascontiguousarray(self.vertices, dtype=np.float64).reshape(-1, 3)
         self.faces = np.ascontiguousarray(self.faces, dtype=np.int32).reshape(-1, 3)
+        if self.uv is not None:
+            self.uv = np.ascontiguousarray(self.uv, dtype=np.float64).reshape(-1, 3, 2)
 
 
 class MeshLibrary:
@@ -38,6 +47,8 @@ class MeshLibrary:
     def add(self, mesh: UnitMesh, key: tuple | None = None) -> int:
         if key is None:
             key = (mesh.name, mesh.vertices.round(12).tobytes(), mesh.faces.tobytes())
+            if mesh.uv is not None:  # a textured asset is another mesh than its bare shape
+                key += (mesh.uv.round(12).tobytes(), getattr(mesh.image, "path", None))
         found = self._index.get(key)
         if found is None:
             found = self._index[key] = len(self.meshes)
@@ -81,6 +92,9 @@ class TerminalTable:
     # when 5 has none) as affine maps: while deriving from WORLD points (16 floats a row), frozen
     # from UNIT scope coordinates, (K, 2, 2, 4): uv = M[:, :3] @ v + M[:, 3] for a unit vertex v
     tex_uv: Any = field(default_factory=list)
+    # whether the colour map's coordinates are the unit mesh's own (an inserted asset's uv,
+    # UnitMesh.uv) instead of tex_uv's map; frozen: (K,) bool
+    tex_own: Any = field(default_factory=list)
     frozen: bool = False
 
     def __len__(self) -> int:
@@ -95,6 +109,7 @@ class TerminalTable:
             self.mesh = np.asarray(self.mesh, dtype=np.int32).reshape(-1)
             self.tex_rows = np.asarray(self.tex_rows, dtype=np.int64).reshape(-1)
             self.tex_maps = np.asarray(self.tex_maps, dtype=np.int32).reshape(-1, 2)
+            self.tex_own = np.asarray(self.tex_own, dtype=bool).reshape(-1)
             self.tex_uv = unit_maps(
                 np.asarray(self.tex_uv, dtype=np.float64).reshape(-1, 2, 2, 4),
                 self.origin[self.tex_rows],
@@ -112,16 +127,23 @@ class TerminalTable:
         self.images.append(image)
         return len(self.images) - 1
 
-    def add_texturing(self, row: int, tex) -> None:
+    def add_texturing(self, row: int, tex, own: int = -1) -> None:
         """Record the texture maps and coordinates of terminal ``row`` (a shape's
-        ``texturing.Texturing``); a shape without a texture map writes nothing here."""
-        if tex.color < 0 and tex.normal < 0:
+        ``texturing.Texturing``, or None); a shape without a texture map writes nothing here.
+        ``own``: the image of the row's unit mesh (an inserted asset's texture), shown with the
+        mesh's own coordinates when the shape sets no colour map (CGA: a material attribute set
+        on the shape overrides the asset's)."""
+        color_map = tex.color if tex is not None else -1
+        normal_map = tex.normal if tex is not None else -1
+        if color_map < 0 and normal_map < 0 and own < 0:
             return
         none = (0.0,) * 8
-        color = tex.uv[0] or none
-        normal = tex.uv[5] or tex.uv[0] or none
+        uv = tex.uv if tex is not None else (None,) * 6
+        color = uv[0] or none
+        normal = uv[5] or uv[0] or none
         self.tex_rows.append(row)
-        self.tex_maps.append((tex.color, tex.normal))
+        self.tex_own.append(color_map < 0 and own >= 0)
+        self.tex_maps.append((color_map if color_map >= 0 else own, normal_map))
         self.tex_uv.append((*color, *normal))
 
     def textured(self) -> bool:
@@ -163,6 +185,7 @@ def texture_part(table: TerminalTable, part: TerminalTable, first: int, end: int
     keep = (table.tex_rows >= first) & (table.tex_rows < end)
     part.tex_rows = table.tex_rows[keep] - first
     part.tex_maps, part.tex_uv = table.tex_maps[keep], table.tex_uv[keep]
+    part.tex_own = table.tex_own[keep]
 
 
 def lot_tables(table: TerminalTable) -> list[TerminalTable]:
@@ -225,10 +248,11 @@ def concat(
     out.origin, out.axes = stacked("origin", (0, 3)), stacked("axes", (0, 3, 3))
     out.size, out.color = stacked("size", (0, 3)), stacked("color", (0, 3))
     out.mesh = np.concatenate(meshes).astype(np.int32) if meshes else np.zeros(0, np.int32)
-    rows, maps, uvs = (
+    rows, maps, uvs, own = (
         [np.zeros(0, np.int64)],
         [np.zeros((0, 2), np.int32)],
         [np.zeros((0, 2, 2, 4))],
+        [np.zeros(0, bool)],
     )
     at = 0
     for part in parts:
@@ -237,8 +261,9 @@ def concat(
             rows.append(part.tex_rows + at)
             maps.append(remap[part.tex_maps])  # -1 stays -1: the appended last entry
             uvs.append(part.tex_uv)
+            own.append(part.tex_own)
         at += len(part)
     out.tex_rows, out.tex_maps = np.concatenate(rows), np.concatenate(maps).astype(np.int32)
-    out.tex_uv = np.concatenate(uvs)
+    out.tex_uv, out.tex_own = np.concatenate(uvs), np.concatenate(own)
     out.frozen = True
     return out

@@ -13,6 +13,7 @@ EXAMPLES = [
     ("house.bgr", []),
     ("tower.bgr", []),
     ("city_block.bgr", []),
+    ("textured_house.bgr", []),
     ("l_building.bgr", ["--lot", str(ROOT / "examples" / "l_lot.geojson")]),
     ("house.bgr", ["--lot", str(ROOT / "examples" / "block.geojson")]),
 ]

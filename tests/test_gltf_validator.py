@@ -32,6 +32,7 @@ EXAMPLES = ROOT / "examples"
 # (name, grammar, lot, seed, attrs): every example as the README and docs derive it
 CASES = [
     ("house", EXAMPLES / "house.bgr", None, 3, {}),
+    ("textured_house", EXAMPLES / "textured_house.bgr", None, 3, {}),
     ("tower", EXAMPLES / "tower.bgr", None, 1, {}),
     ("city_block", EXAMPLES / "city_block.bgr", None, 2, {}),
     ("l_building", EXAMPLES / "l_building.bgr", str(EXAMPLES / "l_lot.geojson"), 1, {}),

@@ -42,7 +42,7 @@ def test_family_counts_follow_the_paper(modules):
     assert len(public(modules["roof"])) >= 6
 
 
-@pytest.mark.parametrize("name", ["mass", "facade", "window", "roof", "palette"])
+@pytest.mark.parametrize("name", ["mass", "facade", "window", "roof", "palette", "textured"])
 def test_every_public_rule_is_documented_with_every_parameter(name):
     grammar = module(name)
     docs = rule_docs(grammar.module)

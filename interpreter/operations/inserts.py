@@ -56,6 +56,7 @@ def _load_asset(app, step, module, asset):
     """Load an OBJ, GLB or PLY once per derivation; its unit mesh, bounding size and offset."""
     cache = app.engine.__dict__.setdefault("asset_cache", {})
     base = Path(module.path).parent if module.path not in ("<text>", "<stdin>") else Path.cwd()
+    base = module.folder or base  # the real folder: a stdlib module's path is only its name
     path = (base / asset.path).resolve()
     if path in cache:
         return cache[path]
@@ -80,18 +81,79 @@ def _load_asset(app, step, module, asset):
         raise runtime_error(
             module, asset.pos, f"asset file '{asset.path}' not found", f"looked for {path}"
         )
-    try:
-        import trimesh
+    textured = _textured(app, module, asset, path)
+    if textured is not None:
+        verts, faces, uv, image = textured
+    else:
+        uv = image = None
+        try:
+            import trimesh
 
-        loaded = trimesh.load(path, force="mesh")
-        verts, faces = np.asarray(loaded.vertices, dtype=float), np.asarray(loaded.faces)
-    except Exception as e:  # any reader failure is the file's fault, not ours
-        raise runtime_error(module, asset.pos, f"cannot read asset '{asset.path}': {e}") from None
+            loaded = trimesh.load(path, force="mesh")
+            verts, faces = np.asarray(loaded.vertices, dtype=float), np.asarray(loaded.faces)
+        except Exception as e:  # any reader failure is the file's fault, not ours
+            raise runtime_error(
+                module, asset.pos, f"cannot read asset '{asset.path}': {e}"
+            ) from None
     if len(verts) == 0:
         raise runtime_error(module, asset.pos, f"asset '{asset.path}' has no geometry")
     lo, hi = verts.min(axis=0), verts.max(axis=0)
     extent = hi - lo
     unit = (verts - lo) / np.where(extent > 0, extent, 1.0)
-    mesh_id = app.engine.table.library.add(UnitMesh(asset.name, unit, faces))
+    mesh_id = app.engine.table.library.add(UnitMesh(asset.name, unit, faces, uv, image))
     cache[path] = (mesh_id, tuple(extent.tolist()), tuple(lo.tolist()))
     return cache[path]
+
+
+TEXTURED_ASSETS = (".obj", ".glb", ".gltf")
+
+
+def _textured(app, module, asset, path: Path):
+    """(vertices, faces, per-corner uv, image) of an OBJ+MTL or glTF asset whose every triangle
+    shows one image, read by bgr's textured-model readers; None for any other asset, which
+    trimesh then reads as before.  An asset with several images, or with an image that is not
+    a PNG or JPEG, is inserted without its texture, with a warning saying why."""
+    if path.suffix.lower() not in TEXTURED_ASSETS:
+        return None
+    from bgr.formats.gltf_textured import read_gltf_textured
+    from bgr.formats.obj_textured import read_obj_textured
+    from bgr.grammar.textures import MAX_IMAGE_BYTES, TextureError, decode_image
+
+    reader = read_obj_textured if path.suffix.lower() == ".obj" else read_gltf_textured
+    try:
+        model = reader(path)
+    except BgrError:  # what bgr's stricter readers refuse, trimesh may still read untextured
+        return None
+    if not len(model.faces) or not model.textured().all():
+        return None  # some faces without an image: the asset's colours, as before
+    used = sorted(set(model.material.tolist()))
+    images = {_image_key(model.materials[k], path) for k in used}
+    if len(images) > 1:
+        app.engine.warn(
+            module,
+            asset.pos,
+            f"asset '{asset.path}' uses {len(images)} images: inserted without its textures",
+            "bgr carries one image per asset; bake its textures into one image",
+        )
+        return None
+    material = model.materials[used[0]]
+    key = images.pop()
+    try:
+        data = material.image_bytes()
+        if len(data) > MAX_IMAGE_BYTES:
+            raise TextureError(f"its image is larger than {MAX_IMAGE_BYTES >> 20} MB")
+        image = decode_image(data, key, f"{asset.path}: {material.name}")
+    except (OSError, ValueError, BgrError) as e:  # TextureError is a ValueError
+        reason = getattr(e, "message", None) or str(e)
+        app.engine.warn(
+            module, asset.pos, f"asset '{asset.path}': {reason}; inserted without its texture"
+        )
+        return None
+    return model.vertices, model.faces, model.uv, image
+
+
+def _image_key(material, path: Path) -> str:
+    """What tells two asset images apart: the image file, or the model and its material."""
+    if material.image is not None:
+        return str(material.image)
+    return f"{path}#{material.name}"

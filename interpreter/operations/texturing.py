@@ -162,16 +162,19 @@ def delete_uv(app, shape, step, args) -> bool:
 
 
 def _image(app, step, path) -> int:
-    """The terminal table's image index of a texture file, read once per derivation."""
+    """The terminal table's image index of a texture file, read once per derivation; -1 for
+    the empty name, which removes the map (CGA: ``set(material.colormap, "")``)."""
     if not isinstance(path, str):
         raise runtime_error(app.module, step.pos, f"'{step.name}' needs a file name, got {path!r}")
+    if path == "":
+        return -1
     engine = app.engine
     cache = engine.__dict__.setdefault("texture_cache", {})
     key = (app.module.path, path)
     found = cache.get(key)
     if found is None:
         try:
-            image = load(app.module.path, app.module.roots, path)
+            image = load(app.module.path, app.module.roots, path, app.module.folder)
         except TextureError as e:
             raise runtime_error(app.module, step.pos, e.message, e.hint) from None
         found = cache[key] = engine.table.add_image(image)
