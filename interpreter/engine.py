@@ -24,9 +24,12 @@ from bgr.grammar.registry import (
     GEOMETRY,
     NORMALIZE_MODE,
     NORMALIZE_TYPE,
+    NUMBER,
     OPERATIONS,
     PROJECTION_AXES,
     ROOF_KIND,
+    SIZE,
+    TEX_SIZE,
 )
 
 from .barren import handed
@@ -61,6 +64,7 @@ SYMBOL_KINDS = {
     NORMALIZE_MODE,
     NORMALIZE_TYPE,
 }
+_NUMERIC_KINDS = {NUMBER, SIZE, TEX_SIZE}  # parameters whose value must be a number
 # operations that move or stretch a shape's geometry with its scope: its texture projections and
 # coordinates follow (texturing.follow).  reverseNormals keeps the outline where it is.
 _MOVERS = frozenset({"t", "r", "s", "center", "matrix"})
@@ -498,12 +502,23 @@ class Application:
         ctx = self.ctx
         out = [
             value if kind == 0 else fn(ctx) if kind == 1 else (value, fn(ctx))
-            for kind, value, fn in plan
+            for kind, value, fn, _ in plan
         ]
         for i, value in enumerate(out):
             number = value[1] if value.__class__ is tuple else value
-            if number.__class__ in _NUMBER and not -MAX_COORDINATE <= number <= MAX_COORDINATE:
-                self.out_of_range(step, i, number)
+            if number.__class__ in _NUMBER:
+                if not -MAX_COORDINATE <= number <= MAX_COORDINATE:
+                    self.out_of_range(step, i, number)
+            elif number.__class__ is str and plan[i][3]:
+                # the checker types most arguments; a value it cannot type, such as
+                # `c ? "a" : 1`, is known only now
+                raise runtime_error(
+                    self.module,
+                    step.pos,
+                    f"'{step.name}' argument {i + 1} must be a number, "
+                    f"got the string {number!r:.40}",
+                    "a conditional or function that gives a string here?",
+                )
         out.append(received)
         return out
 
@@ -518,7 +533,8 @@ class Application:
         )
 
     def plan(self, step: n.Operation) -> tuple:
-        """(kind, constant, compiled) per parameter: 0 a word or default, 1 a value, 2 relative."""
+        """(kind, constant, compiled, numeric) per parameter: kind 0 a word or default, 1 a
+        value, 2 relative; numeric: the parameter takes a number (or a size)."""
         spec, count = OPERATIONS[step.name], len(step.args)
         sig = next(
             s
@@ -527,17 +543,20 @@ class Application:
         )
         plan = []
         for i, param in enumerate(sig):
+            numeric = param.kind in _NUMERIC_KINDS
             if i >= count:
-                plan.append((0, param.default, None))
+                plan.append((0, param.default, None, numeric))
                 continue
             arg = step.args[i]
             if param.kind in SYMBOL_KINDS:
-                plan.append((0, arg.name, None))
+                plan.append((0, arg.name, None, False))
             elif isinstance(arg, n.Relative):
                 tag = "float" if arg.floating else "rel"
-                plan.append((2, tag, self.engine.compiled(self.compiler, arg.expr, self.local)))
+                compiled = self.engine.compiled(self.compiler, arg.expr, self.local)
+                plan.append((2, tag, compiled, numeric))
             else:
-                plan.append((1, None, self.engine.compiled(self.compiler, arg, self.local)))
+                compiled = self.engine.compiled(self.compiler, arg, self.local)
+                plan.append((1, None, compiled, numeric))
         return tuple(plan)
 
     def successor(self, shape: Shape, step: n.Successor, handover: bool = False) -> None:

@@ -97,6 +97,13 @@ REPRODUCERS = {
     "unused_attr": ("attr a = 1e308 * 10\nLot --> extrude(3)", "", "'a' is inf"),
     "split_inf": ("Lot --> split(x) { 1e308 * 10: T }", "", "finite"),
     "offset_inf": ("Lot --> offset(1e308 * 10) { inside: T }", "", "'offset' argument 1 is inf"),
+    # a string where a number goes, which the checker cannot type (test_fuzz found it)
+    "offset_string": (
+        'Lot --> offset(0 ? "a" : "") { inside: T }',
+        "",
+        "'offset' argument 1 must be a number, got the string ''",
+    ),
+    "extrude_string": ('Lot --> extrude(1 ? "3" : 2)', "", "argument 1 must be a number"),
     "offset_outward": ("Lot --> offset(-1e9) { border: T }", "", "'offset' makes a scope"),
     "circle_inf": ("Lot --> footprint(circle, 1e308 * 10)", "", "'footprint' argument 2 is inf"),
     "taper_ratio": ("Lot --> taper(3, 1e300)", "", "'taper' argument 2 is 1e+300"),
