@@ -515,9 +515,9 @@ class Application:
                 raise runtime_error(
                     self.module,
                     step.pos,
-                    f"'{step.name}' argument {i + 1} must be a number, "
-                    f"got the string {number!r:.40}",
-                    "a conditional or function that gives a string here?",
+                    f"{step.name}() needs a finite number, got {number!r:.40} (argument {i + 1})",
+                    "a string where a number goes: an attr set to text, or a conditional "
+                    "whose branches give a string?",
                 )
         out.append(received)
         return out

@@ -101,9 +101,13 @@ REPRODUCERS = {
     "offset_string": (
         'Lot --> offset(0 ? "a" : "") { inside: T }',
         "",
-        "'offset' argument 1 must be a number, got the string ''",
+        "offset() needs a finite number, got '' (argument 1)",
     ),
-    "extrude_string": ('Lot --> extrude(1 ? "3" : 2)', "", "argument 1 must be a number"),
+    "extrude_string": (
+        'Lot --> extrude(1 ? "3" : 2)',
+        "",
+        "extrude() needs a finite number, got '3'",
+    ),
     "offset_outward": ("Lot --> offset(-1e9) { border: T }", "", "'offset' makes a scope"),
     "circle_inf": ("Lot --> footprint(circle, 1e308 * 10)", "", "'footprint' argument 2 is inf"),
     "taper_ratio": ("Lot --> taper(3, 1e300)", "", "'taper' argument 2 is 1e+300"),
