@@ -155,17 +155,17 @@ class UvSets:
         textures: list[tuple[str | None, str | None]],
         pool: MeshPool,
     ) -> UvSets:
-        uv_rows = (
-            [r for r in baked.tolist() if textures[int(mats.index[r])] != (None, None)]
-            if len(table.tex_rows)
-            else []
-        )
-        has_normal = {k for k, t in enumerate(textures) if t[1] is not None}
-        normal_rows = [r for r in uv_rows if int(mats.index[r]) in has_normal]
-        rows, at, corners = [uv_rows, normal_rows], [], []
-        for chosen in rows:
-            starts = 3 * face_offsets(table, np.asarray(chosen, np.int64), pool)
-            at.append(dict(zip(chosen, starts[:-1].tolist(), strict=True)))
+        index = np.asarray(mats.index, dtype=np.int64)
+        baked = np.asarray(baked, dtype=np.int64)
+        textured = np.array([t != (None, None) for t in textures] + [False], dtype=bool)
+        has_normal = np.array([t[1] is not None for t in textures] + [False], dtype=bool)
+        uv_rows = baked[textured[index[baked]]] if len(table.tex_rows) else baked[:0]
+        normal_rows = uv_rows[has_normal[index[uv_rows]]]
+        rows, at, corners = [], [], []
+        for chosen in (uv_rows, normal_rows):
+            starts = 3 * face_offsets(table, chosen, pool)
+            rows.append(chosen.tolist())
+            at.append(dict(zip(rows[-1], starts[:-1].tolist(), strict=True)))
             corners.append(int(starts[-1]))
         return cls(rows, at, corners)
 

@@ -42,15 +42,17 @@ def cga_corner_uvs(
     start = np.concatenate([[0], np.cumsum(fcount)])
     out = np.empty((int(start[-1]), 3, 2), dtype=np.float64)
     flip = mirrored(table, rows)
-    for m in np.unique(mesh):  # one product per unit mesh shape, every row of it at once
-        sel = np.flatnonzero(mesh == m)
+    order = np.argsort(mesh, kind="stable")  # the rows of each unit mesh together
+    cuts = np.flatnonzero(np.diff(mesh[order])) + 1
+    for sel in np.split(order, cuts) if len(order) else []:
+        m = mesh[sel[0]]  # one product per unit mesh shape, every row of it at once
         F = int(pool.fcount[m])
         if F == 0:
             continue
         lo = pool.foff[m]
         unit = pool.vertices[pool.faces[lo : lo + F].reshape(-1) + pool.voff[m]]  # (3F, 3)
-        uv = np.einsum("nij,vj->nvi", maps[sel, :, :3], unit) + maps[sel, None, :, 3]
-        tri = uv.reshape(len(sel), F, 3, 2)
+        uv = np.matmul(maps[sel, :, :3], unit.T) + maps[sel, :, 3:]  # (n, 2, 3F)
+        tri = uv.transpose(0, 2, 1).reshape(len(sel), F, 3, 2)
         if pool.uv is not None and own[sel].any():
             tri[own[sel]] = pool.uv[lo : lo + F]
         tri[flip[sel]] = tri[flip[sel]][:, :, [0, 2, 1]]  # re-wound as place_corners does

@@ -14,6 +14,8 @@ from typing import Any
 
 import numpy as np
 
+_NO_MAP = (0.0,) * 8  # the affine map of a texture without coordinates: (0, 0) everywhere
+
 
 @dataclass
 class UnitMesh:
@@ -133,18 +135,22 @@ class TerminalTable:
         ``own``: the image of the row's unit mesh (an inserted asset's texture), shown with the
         mesh's own coordinates when the shape sets no colour map (CGA: a material attribute set
         on the shape overrides the asset's)."""
-        color_map = tex.color if tex is not None else -1
-        normal_map = tex.normal if tex is not None else -1
+        if tex is None:
+            color_map = normal_map = -1
+            color = normal = _NO_MAP
+        else:
+            color_map, normal_map, uv = tex.color, tex.normal, tex.uv
+            color = uv[0] or _NO_MAP
+            normal = uv[5] or color
         if color_map < 0 and normal_map < 0 and own < 0:
             return
-        none = (0.0,) * 8
-        uv = tex.uv if tex is not None else (None,) * 6
-        color = uv[0] or none
-        normal = uv[5] or uv[0] or none
+        # flat lists while deriving: numpy reads a list of floats many times faster than a list
+        # of tuples when the table is frozen
         self.tex_rows.append(row)
         self.tex_own.append(color_map < 0 and own >= 0)
-        self.tex_maps.append((color_map if color_map >= 0 else own, normal_map))
-        self.tex_uv.append((*color, *normal))
+        self.tex_maps += (color_map if color_map >= 0 else own, normal_map)
+        self.tex_uv += color
+        self.tex_uv += normal
 
     def textured(self) -> bool:
         return len(self.tex_rows) > 0
