@@ -14,10 +14,11 @@ import numpy as np
 import pytest
 from conftest import SHARED
 from PIL import Image
+from test_render import BACKENDS, gl_or_skip
 
 import bgr
 from bgr.cli import main
-from bgr.render import Camera, images, load_scene, make_camera, raster_gl, rasterise, render
+from bgr.render import Camera, images, load_scene, make_camera, rasterise, render
 from bgr.render.scene import Scene
 
 PLATEAU = SHARED / "data" / "textured" / "plateau_tokyo" / "53392633_bldg_6697_2_op.gml"
@@ -84,16 +85,6 @@ class Face:
 def linear(srgb) -> np.ndarray:
     c = np.asarray(srgb, dtype=np.float64) / 255.0
     return np.where(c <= 0.04045, c / 12.92, ((c + 0.055) / 1.055) ** 2.4)
-
-
-def gl_or_skip():
-    try:
-        raster_gl._context()
-    except raster_gl.GLUnavailable as exc:
-        pytest.skip(f"no GL context on this machine: {exc}")
-
-
-BACKENDS = [pytest.param("numpy", id="numpy"), pytest.param("gl", id="gl")]
 
 
 def quadrant_png(path, size: int = 8) -> None:
