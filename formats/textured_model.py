@@ -65,13 +65,12 @@ class Material:
         return self.image is not None or self.data is not None
 
     def image_size(self) -> tuple[int, int]:
-        """(width, height) of the image in pixels, from its header (Pillow; read once)."""
+        """(width, height) of the image in pixels, from its header (Pillow; read once);
+        ValueError for one of more than ``bgr.grammar.textures.MAX_IMAGE_PIXELS``."""
         if self._size is None:
-            import io
+            from bgr.grammar.textures import open_image
 
-            from PIL import Image
-
-            with Image.open(io.BytesIO(self.image_bytes())) as im:
+            with open_image(self.image_bytes()) as im:
                 self._size = (int(im.width), int(im.height))
         return self._size
 

@@ -229,6 +229,8 @@ def _model_errors(shown: str, what: str, hint: str, caught: tuple = (Exception,)
     except FileNotFoundError:
         raise BgrError(Diagnostic(shown, 0, 0, "no such file", "check the path")) from None
     except BgrError as exc:
+        if exc.path:  # located already (the model at its line, or its MTL file): keep it
+            raise
         raise BgrError(Diagnostic(shown, 0, 0, exc.message, exc.hint)) from None
     except OSError as exc:
         raise BgrError(

@@ -24,6 +24,7 @@ import numpy as np
 import pytest
 from hypothesis import HealthCheck, given, note, settings
 from hypothesis import strategies as st
+from PIL import Image
 
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT / "bench"))
@@ -32,6 +33,7 @@ import fuzz_inverse  # noqa: E402  (the mutators and the runner live with the lo
 
 CASES = max(1, int(__import__("os").environ.get("BGR_FUZZ_CASES") or 10))
 SLOW_CASES = 200
+SLOW_CASES_TEXTURED = 300  # the textured surfaces' cases are short (0.1 to 0.4 s each)
 # twice the bench's 10 s: CI runs these beside other tests on shared cores, where the slowest
 # case of 14,000 took 6 s; the long runs in docs/fuzzing.md hold the 10 s limit
 TIMEOUT_S = 2 * fuzz_inverse.TIMEOUT_S
@@ -59,11 +61,14 @@ def test_seeds_are_read(seeds, surface, tmp_path):
     for k, seed in enumerate(seeds[surface]):
         folder = tmp_path / str(k)
         folder.mkdir()
-        (folder / seed.name).write_bytes(seed.data)
-        for name, extra in seed.extra.items():
-            (folder / name).write_bytes(extra)
+        seed.write(folder)
         outcome = _run(folder, fuzz_inverse.command(surface, seed.name, random.Random(0)))
         assert outcome.kind == "success", (seed.name, outcome.stderr)
+        if surface in fuzz_inverse.fuzz_textured.SURFACES:  # rendered: a PNG with its textures
+            assert "cannot be read" not in outcome.stderr, outcome.stderr
+            assert "missing" not in outcome.stderr, outcome.stderr
+            with Image.open(folder / "out.png") as image:
+                assert image.size == fuzz_inverse.fuzz_textured.SIZE
 
 
 @pytest.mark.parametrize("surface", fuzz_inverse.SURFACES)
@@ -77,7 +82,8 @@ def test_mutants_succeed_or_fail_cleanly(seeds, surface):
 def test_a_few_hundred_mutants_of_each_reader(seeds, surface):
     """The same property over SLOW_CASES mutants a surface (issue 25: a few hundred cases per
     reader per run; the long runs of bench/fuzz_inverse.py are in docs/fuzzing.md)."""
-    _fuzz(seeds, surface, SLOW_CASES)
+    textured = surface in fuzz_inverse.fuzz_textured.SURFACES
+    _fuzz(seeds, surface, SLOW_CASES_TEXTURED if textured else SLOW_CASES)
 
 
 def _fuzz(seeds, surface: str, cases: int) -> None:
@@ -403,3 +409,150 @@ def test_the_budgets_come_before_min_length(monkeypatch):
     monkeypatch.setattr(retarget_module, "min_length", walked)
     with pytest.raises(BgrError, match=f"has {MAX_CHILDREN + 1:,} children"):
         retarget_module.retarget_axis(root, 1, 2.0)
+
+
+# ---------------------------------------------------------------- textured readers (issue 26)
+
+
+def _textured_seed(seeds, surface: str, name: str) -> fuzz_inverse.Seed:
+    return next(s for s in seeds[surface] if s.name == name)
+
+
+def test_seeds_cover_every_textured_reader(seeds):
+    """The hand-written CityGML (EPSG:6697 and a projected CRS), a textured OBJ+MTL and the
+    derived GLB and glTF are seeds whether or not the shared PLATEAU data is here."""
+    names = {s.name for k in fuzz_inverse.fuzz_textured.SURFACES for s in seeds[k]}
+    assert {"wall_6697.gml", "wall_6677.gml", "model.obj", "model.glb", "model.gltf"} <= names
+    glb = json.loads(_textured_seed(seeds, "gltf-tex", "model.gltf").data)
+    assert glb["images"] and glb["textures"] and "TEXCOORD_0" in str(glb["meshes"])
+
+
+def _png_claiming(width: int, height: int) -> bytes:
+    """A real 8 x 8 PNG whose header (checksum right) claims ``width`` x ``height``."""
+    import fuzz_textured
+
+    data = fuzz_textured.png(8, 8)
+    body = width.to_bytes(4, "big") + height.to_bytes(4, "big") + data[24:29]
+    return data[:8] + fuzz_textured._png_chunk(b"IHDR", body) + data[33:]
+
+
+@pytest.mark.parametrize(
+    "image", ["12000x12000 header", "100000x100000 header", "12000x12000 1-bit"]
+)
+def test_a_texture_claiming_too_many_pixels_is_refused_before_decoding(seeds, tmp_path, image):
+    """A PNG header claiming 12,000 x 12,000 pixels (144 M, past Pillow's 89 M warning limit)
+    leaked Pillow's DecompressionBombWarning to the terminal, and a real 1-bit PNG of that size
+    (18 KB) decoded to 432 MB and ran out of memory in the mipmaps; now the header's size is
+    checked against MAX_IMAGE_PIXELS first: the surface is drawn in its colour, with a
+    warning that says why, and nothing is decoded."""
+    import fuzz_textured
+
+    from bgr.grammar.textures import MAX_IMAGE_PIXELS, open_image
+    from bgr.render.textured import decode
+
+    if image.endswith("1-bit"):
+        data = fuzz_textured._bomb_png()
+    else:
+        data = _png_claiming(*map(int, image.split()[0].split("x")))
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # Pillow's bomb warning would raise here
+        with pytest.raises(ValueError, match="pixels, more than"):
+            decode(data)
+        with open_image(fuzz_textured.png(8, 8)) as ok:
+            assert ok.size == (8, 8)
+    assert MAX_IMAGE_PIXELS < 89_478_485  # below Pillow's own limit, so it never speaks first
+    seed = _textured_seed(seeds, "citygml", "wall_6677.gml")
+    seed.write(tmp_path)
+    (tmp_path / "tex" / "wall.png").write_bytes(data)
+    outcome = _run(tmp_path, fuzz_textured.command(seed.name))
+    assert outcome.kind == "success", outcome.stderr
+    assert "pixels, more than 33,554,432 (8192 x 4096)" in outcome.stderr, outcome.stderr
+
+
+def test_a_grammar_texture_claiming_too_many_pixels_is_a_located_error(tmp_path):
+    """The same limit holds for a grammar's texture(): a located error, no Pillow warning."""
+    import bgr
+    from bgr.grammar.errors import BgrError
+
+    (tmp_path / "big.png").write_bytes(_png_claiming(12_000, 12_000))
+    (tmp_path / "t.bgr").write_text('Lot --> extrude(3) texture("big.png")\n')
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        with pytest.raises(BgrError, match="12,000 x 12,000 pixels"):
+            bgr.derive(bgr.load(tmp_path / "t.bgr"))
+
+
+@pytest.mark.parametrize("encoding", ["UTF-3", "Shift_JIS", "x" * 300])
+def test_citygml_with_an_encoding_expat_cannot_use_is_located(tmp_path, encoding):
+    """An XML declaration naming an unknown encoding (a byte flip made UTF-8 UTF-3) or a
+    multi-byte one expat cannot take was an internal error (LookupError, ValueError)."""
+    from bgr.formats.citygml_read import read_citygml
+    from bgr.grammar.errors import BgrError
+
+    path = tmp_path / "city.gml"
+    path.write_text(f'<?xml version="1.0" encoding="{encoding}"?>\n<core:CityModel/>\n')
+    with pytest.raises(BgrError) as info:
+        read_citygml(path)
+    err = info.value
+    assert "encoding cannot be read" in err.message and err.line == 1
+    assert err.path == str(path) and len(err.message) < 200
+
+
+def test_an_mtl_repeating_map_kd_100000_times_resolves_the_image_once(seeds, tmp_path, monkeypatch):
+    """An MTL whose map_Kd line was repeated 100,000 times resolved the same path 100,000 times
+    (10 s, a timeout); each distinct name is now resolved, and a missing one warned of, once."""
+    from bgr.formats import obj_textured
+
+    seed = _textured_seed(seeds, "obj-mtl", "model.obj")
+    seed.write(tmp_path)
+    mtl = (tmp_path / "model.mtl").read_text()
+    many = "map_Kd tex/brick.png\n" * 100_000 + "map_Kd tex/absent.png\n" * 100_000
+    (tmp_path / "model.mtl").write_text(mtl.replace("map_Kd tex/brick.png\n", many))
+    calls = []
+    real = obj_textured.image_path
+
+    def counted(folder, name):
+        calls.append(name)
+        return real(folder, name)
+
+    monkeypatch.setattr(obj_textured, "image_path", counted)
+    mesh = obj_textured.read_obj_textured(tmp_path / "model.obj")
+    assert sorted(calls) == ["model.mtl", "tex/absent.png", "tex/brick.png"]
+    assert [w.message for w in mesh.warnings] == [
+        "map_Kd 'tex/absent.png' is missing: its faces are left untextured"
+    ]
+
+
+def test_an_mtl_error_names_the_mtl_as_the_user_wrote_it(seeds, tmp_path):
+    """An error in an MTL file named its resolved absolute path; it now names it beside the
+    OBJ as the user gave it (``model.mtl:2:1:``), as the located-message rule asks."""
+    seed = _textured_seed(seeds, "obj-mtl", "model.obj")
+    seed.write(tmp_path)
+    (tmp_path / "model.mtl").write_text("newmtl brick\nKd x y z\nmap_Kd tex/brick.png\n")
+    outcome = _run(tmp_path, fuzz_inverse.fuzz_textured.command("model.obj"))
+    assert outcome.kind == "error" and outcome.stderr.startswith("model.mtl:2:1:"), outcome.stderr
+
+
+@pytest.mark.parametrize(
+    ("srs", "message"),
+    [("EPSG:6697", "outside latitude -90..90"), ("EPSG:4326", "outside latitude -90..90")],
+)
+def test_projected_coordinates_under_a_geographic_crs_are_located(seeds, tmp_path, srs, message):
+    """The projected wall (x -35,000, y -6,000 m) under a geographic srsName: pyproj refused a
+    transverse Mercator centred at latitude -34,998 (CRSError, an internal error); now the
+    degrees are checked first and the message names the file."""
+    seed = _textured_seed(seeds, "citygml", "wall_6677.gml")
+    seed.write(tmp_path, seed.data.replace(b'srsName="EPSG:6677"', f'srsName="{srs}"'.encode()))
+    outcome = _run(tmp_path, fuzz_inverse.fuzz_textured.command(seed.name))
+    assert outcome.kind == "error", outcome.stderr
+    assert outcome.stderr.startswith("wall_6677.gml") and message in outcome.stderr
+
+
+def test_a_model_spanning_the_globe_is_refused_not_drawn_at_infinity():
+    """Degrees in range but 90 degrees either side of the centre on the equator: the local
+    transverse Mercator makes infinite coordinates there, refused rather than drawn."""
+    from bgr.render.textured import local_frame
+
+    v = np.array([[0.0, -90.0, 0.0], [0.0, 90.0, 0.0], [10.0, 0.0, 0.0]])
+    with pytest.raises(ValueError, match="too much of the globe"):
+        local_frame(v, "z", "EPSG:4326")
