@@ -556,3 +556,131 @@ def test_a_model_spanning_the_globe_is_refused_not_drawn_at_infinity():
     v = np.array([[0.0, -90.0, 0.0], [0.0, 90.0, 0.0], [10.0, 0.0, 0.0]])
     with pytest.raises(ValueError, match="too much of the globe"):
         local_frame(v, "z", "EPSG:4326")
+
+
+def test_texture_coordinates_of_1e30_are_sampled_without_a_warning(seeds, tmp_path):
+    """A glTF buffer holds any float: TEXCOORD_0 of 1e30 (a byte flip in the .bin) was cast to
+    int64 past its range (numpy's "invalid value encountered in cast" on the terminal).  Now
+    the texel coordinates are brought into one period first; u = 2^20 + 0.25 samples what
+    u = 0.25 does (REPEAT)."""
+    from bgr.render.textured import Texture
+    from bgr.render.texturing import _bilinear, sample
+
+    rgb = np.arange(4 * 4 * 3, dtype=np.uint8).reshape(4, 4, 3) * 5
+    uv = np.array([[0.25, 0.5], [2.0**20 + 0.25, 0.5 - 2.0**20], [1e30, -1e300], [1e308, 1e308]])
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        for wrap in ("wrap", "mirror", "clamp"):
+            out = _bilinear(rgb, uv, wrap)
+            assert np.isfinite(out).all()
+            if wrap == "wrap":
+                np.testing.assert_allclose(out[1], out[0], atol=1e-12)
+            sample(Texture(rgb, wrap), uv, "nearest")
+    seed = _textured_seed(seeds, "gltf-tex", "external.gltf")
+    doc = json.loads(seed.data)
+    prims = [p for m in doc["meshes"] for p in m["primitives"]]
+    prim = next(p for p in prims if "TEXCOORD_0" in p["attributes"])
+    accessor = doc["accessors"][prim["attributes"]["TEXCOORD_0"]]
+    view = doc["bufferViews"][accessor["bufferView"]]
+    start = view.get("byteOffset", 0) + accessor.get("byteOffset", 0)
+    blob = bytearray(seed.extra["model.bin"])
+    blob[start : start + 8 * accessor["count"]] = np.full(
+        2 * accessor["count"], 1e30, dtype="<f4"
+    ).tobytes()
+    seed.write(tmp_path)
+    (tmp_path / "model.bin").write_bytes(bytes(blob))
+    outcome = _run(tmp_path, fuzz_inverse.fuzz_textured.command(seed.name))
+    assert outcome.kind == "success", outcome.stderr
+
+
+def test_a_ring_repeating_its_points_1000_times_is_not_given_to_earcut(
+    seeds, tmp_path, monkeypatch
+):
+    """A posList of the wall's square repeated 1,000 times (4,000 points, 4 distinct) took
+    earcut 16 to 20 s (its time grows as a power of the copies: 300 copies 0.35 s); a surface
+    whose points repeat more than MAX_REPEATED_POINTS times is fanned instead."""
+    import time
+
+    from bgr.formats.cityjson import MAX_REPEATED_POINTS, _triangulate
+
+    square = np.array([[0, 0, 0], [4, 0, 0], [4, 0, 3], [0, 0, 3]], dtype=np.float64)
+    points = np.tile(square, (1000, 1))
+    start = time.perf_counter()
+    tri = _triangulate(points, [list(range(len(points)))])
+    assert time.perf_counter() - start < 1.0 and len(tri) == len(points) - 2
+    import mapbox_earcut
+
+    calls = []
+    real = mapbox_earcut.triangulate_float64
+    monkeypatch.setattr(
+        mapbox_earcut, "triangulate_float64", lambda *a: calls.append(1) or real(*a)
+    )
+    twice = np.tile(square, (2, 1))  # points visited twice, as a keyhole does: earcut as before
+    _triangulate(twice, [list(range(8))])
+    _triangulate(points, [list(range(len(points)))])
+    assert calls == [1] and MAX_REPEATED_POINTS >= 4
+    seed = _textured_seed(seeds, "citygml", "wall_6677.gml")
+    text = seed.data.decode()
+    lo, hi = text.index(">", text.index("<gml:posList")) + 1, text.index("</gml:posList>")
+    ring = " ".join(text[lo:hi].split()[:12])  # the square without its closing point
+    seed.write(tmp_path, (text[:lo] + " ".join([ring] * 1000) + text[hi:]).encode())
+    outcome = _run(tmp_path, fuzz_inverse.fuzz_textured.command(seed.name))
+    assert outcome.kind in ("success", "error") and outcome.seconds < 5, outcome
+
+
+def test_an_obj_face_repeated_100000_times_is_drawn_once(seeds, tmp_path):
+    """100,000 copies of one face line made 200,000 triangles on the same pixels: 12 s and
+    1.6 GB in the numpy rasteriser (fragments were kept until one z-test at the end).  A face
+    line that repeats an earlier one is read once, and the rasteriser folds each block of
+    fragments into the buffers as it goes."""
+    from bgr.formats.obj_textured import read_obj_textured
+
+    seed = _textured_seed(seeds, "obj-mtl", "model.obj")
+    face = b"f 5/7/5 6/7/5 7/7/5 8/7/5\n"
+    seed.write(tmp_path, seed.data.replace(face, face * 100_000))
+    mesh = read_obj_textured(tmp_path / "model.obj")
+    assert len(mesh.faces) == 10
+    twice = seed.data.replace(b"usemtl plain\n", b"usemtl plain\nf 1/7/5 2/7/5 6/7/5\n")
+    (tmp_path / "model.obj").write_bytes(twice)  # the same corners under another material
+    assert len(read_obj_textured(tmp_path / "model.obj").faces) == 11
+
+
+def test_the_rasteriser_merges_blocks_as_one_z_test(monkeypatch):
+    """The numpy rasteriser's blocks of fragments, folded into the buffers one by one, give
+    exactly the frame of one z-test over all of them: the nearest fragment, and of coplanar
+    copies the lowest triangle index."""
+    from bgr.render import make_camera, raster_numpy
+    from bgr.render.scene import Scene
+
+    rng = np.random.default_rng(3)
+    base = rng.uniform(-4, 4, (300, 3, 3))
+    tris = np.concatenate([base, base[::-1]])  # every triangle twice: ties everywhere
+    n = len(tris)
+    scene = Scene(tris, np.full((n, 3), 200, np.uint8), np.arange(n), np.zeros(n, int), ["x"])
+    camera = make_camera("iso", scene, (96, 64))
+    whole = raster_numpy.rasterise(tris, camera)
+    monkeypatch.setattr(raster_numpy, "CHUNK", 64)
+    blocks = raster_numpy.rasterise(tris, camera)
+    assert (whole.triangle >= 0).sum() > 1000
+    np.testing.assert_array_equal(blocks.triangle, whole.triangle)
+    np.testing.assert_array_equal(blocks.depth, whole.depth)
+    assert whole.triangle[whole.triangle >= 0].max() < 300  # the lower copy wins each tie
+    # and memory stays bounded by the block size: 20,000 copies of a triangle over the view
+    import tracemalloc
+
+    monkeypatch.undo()  # the real block size
+    big = np.repeat(np.array([[[-50.0, -50, 0], [50, -50, 0], [0, 50, 0]]]), 20_000, axis=0)
+    front = make_camera("front", Scene(big[:1], *_one_colour(1)), (64, 48))
+    tracemalloc.start()
+    try:
+        frame = raster_numpy.rasterise(big, front)
+        peak = tracemalloc.get_traced_memory()[1]
+    finally:
+        tracemalloc.stop()
+    covered = frame.triangle >= 0
+    assert covered.sum() > 500 and (frame.triangle[covered] == 0).all()
+    assert peak < 250e6, peak  # fragments kept to the end: 20,000 x 968 of them, over 460 MB
+
+
+def _one_colour(n: int) -> tuple:
+    return np.full((n, 3), 200, np.uint8), np.arange(n), np.zeros(n, int), ["x"]
