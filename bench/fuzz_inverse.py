@@ -351,7 +351,8 @@ def run_case(argv: list[str], folder: Path, timeout: float = TIMEOUT_S,
     left = [p.name for p in folder.rglob("*.tmp")]
     if left:
         return Outcome("left temporaries", seconds, stderr)
-    if "Traceback" in stderr or "internal error" in stderr:
+    head = whole[:4000]  # a long message may push "internal error" out of the tail
+    if any(word in text for word in ("Traceback", "internal error") for text in (head, stderr)):
         return Outcome("internal", seconds, stderr)
     if _PY_WARNING.search(stderr):
         return Outcome("python warning", seconds, stderr)

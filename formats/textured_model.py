@@ -126,8 +126,15 @@ def image_path(folder: Path, uri: str) -> Path:
     name = unquote(uri).replace("\\", "/")
     if not name or name.startswith("/") or _DRIVE.match(name) or "\0" in name:
         raise ValueError("is not a relative path inside the model's folder")
+    if len(name.encode("utf-8", "surrogatepass")) > 4096 or any(
+        len(part.encode("utf-8", "surrogatepass")) > 255 for part in name.split("/")
+    ):  # past PATH_MAX or NAME_MAX: stat() would raise ENAMETOOLONG
+        raise ValueError("cannot be a file name (File name too long)")
     root = resolved(folder)
-    target = resolved(root / name)
+    try:
+        target = resolved(root / name)
+    except OSError as exc:  # a name of 100,000 characters: ENAMETOOLONG
+        raise ValueError(f"cannot be a file name ({exc.strerror or exc})") from None
     if not target.is_relative_to(root):
         raise ValueError("lies outside the model's folder")
     return target

@@ -684,3 +684,24 @@ def test_the_rasteriser_merges_blocks_as_one_z_test(monkeypatch):
 
 def _one_colour(n: int) -> tuple:
     return np.full((n, 3), 200, np.uint8), np.arange(n), np.zeros(n, int), ["x"]
+
+
+@pytest.mark.parametrize(
+    ("surface", "name", "old"),
+    [
+        ("citygml", "wall_6677.gml", b"tex/wall.png"),
+        ("obj-mtl", "model.obj", b"tex/brick.png"),
+        ("gltf-tex", "external.gltf", b'"t.png"'),
+    ],
+)
+def test_an_image_name_of_100000_characters_is_a_located_error(seeds, tmp_path, surface, name, old):
+    """An image path of 100,000 characters reached the resolver, whose OSError (ENAMETOOLONG)
+    was an internal error; it is now the reader's error at the file that names it."""
+    seed = _textured_seed(seeds, surface, name)
+    seed.write(tmp_path)
+    new = b'"' + b"a" * 100_000 + b'"' if old.startswith(b'"') else b"a" * 100_000
+    target = tmp_path / ("model.mtl" if surface == "obj-mtl" else name)
+    target.write_bytes(target.read_bytes().replace(old, new))
+    outcome = _run(tmp_path, fuzz_inverse.fuzz_textured.command(name))
+    assert outcome.kind == "error", outcome.stderr[:300]
+    assert "cannot be a file name" in outcome.stderr, outcome.stderr[:300]
