@@ -17,6 +17,7 @@ converted in bulk (numpy), the lines classified in one pass.
 
 from __future__ import annotations
 
+import math
 from pathlib import Path
 
 import numpy as np
@@ -235,6 +236,8 @@ def _mtl(text: str, path: Path, shown: str, obj: _Obj) -> list[Material]:
                 values = [float(t) for t in rest.split()]
             except ValueError:
                 raise BgrError(Diagnostic(shown, n, 1, f"{key} must be numbers")) from None
+            if not all(math.isfinite(v) for v in values):  # NaN was a NaN colour, cast to uint8
+                raise BgrError(Diagnostic(shown, n, 1, f"{key} must be finite numbers"))
             r, g, b, a = out[-1].color
             if key == "Kd" and len(values) >= 3:
                 r, g, b = (min(max(c, 0.0), 1.0) for c in values[:3])

@@ -705,3 +705,15 @@ def test_an_image_name_of_100000_characters_is_a_located_error(seeds, tmp_path, 
     outcome = _run(tmp_path, fuzz_inverse.fuzz_textured.command(name))
     assert outcome.kind == "error", outcome.stderr[:300]
     assert "cannot be a file name" in outcome.stderr, outcome.stderr[:300]
+
+
+@pytest.mark.parametrize("line", ["Kd nan nan nan", "Kd 1 inf 0", "d nan", "Tr -inf"])
+def test_an_mtl_colour_of_nan_is_a_located_error(seeds, tmp_path, line):
+    """``Kd nan nan nan`` passed min/max as NaN (``max(nan, 0.0)`` is NaN) and reached the
+    renderer's uint8 cast (numpy's "invalid value encountered in cast")."""
+    seed = _textured_seed(seeds, "obj-mtl", "model.obj")
+    seed.write(tmp_path)
+    (tmp_path / "model.mtl").write_text(f"newmtl brick\n{line}\nmap_Kd tex/brick.png\n")
+    outcome = _run(tmp_path, fuzz_inverse.fuzz_textured.command("model.obj"))
+    assert outcome.kind == "error", outcome.stderr
+    assert outcome.stderr.startswith("model.mtl:2:1:") and "finite" in outcome.stderr
