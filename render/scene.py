@@ -163,6 +163,29 @@ def from_result(result: Any) -> Scene:
     )
 
 
+def _finite(scene: Scene, shown: str) -> Scene:
+    """``scene`` when every corner of a model read from ``shown`` is finite and within
+    MAX_INPUT_COORDINATE of the origin, as bgr's model readers require; else a located error.
+    An OBJ without a readable MTL is read by trimesh, which takes ``v 0 1e400 0`` as inf: the
+    camera and the clipping made NaN of it (numpy's warnings on the terminal)."""
+    from ..interpreter.limits import MAX_INPUT_COORDINATE
+
+    corners = scene.triangles.reshape(-1, 3)
+    bad = ~(np.abs(corners) <= MAX_INPUT_COORDINATE).all(axis=1)
+    if bad.any():
+        point = ", ".join(f"{c:.6g}" for c in corners[int(np.argmax(bad))])
+        raise BgrError(
+            Diagnostic(
+                shown,
+                0,
+                0,
+                f"a vertex ({point}) is not finite or lies beyond {MAX_INPUT_COORDINATE:.0e}",
+                "bgr draws models in metres about their centre",
+            )
+        )
+    return scene
+
+
 def from_trimesh(
     mesh: Any, material_names: list[str] | None = None, material_of_face: np.ndarray | None = None
 ) -> Scene:
@@ -467,11 +490,11 @@ def load_scene(
             )
             return from_result(result)
         if suffix in (".glb", ".gltf"):
-            return from_gltf(path)
+            return _finite(from_gltf(path), str(source))
         if suffix in (".obj", ".ply"):
-            return from_mesh_file(path)
+            return _finite(from_mesh_file(path), str(source))
         if suffix == ".gml":
-            return from_citygml(path)
+            return _finite(from_citygml(path), str(source))
         raise BgrError(
             Diagnostic(
                 str(source),

@@ -717,3 +717,16 @@ def test_an_mtl_colour_of_nan_is_a_located_error(seeds, tmp_path, line):
     outcome = _run(tmp_path, fuzz_inverse.fuzz_textured.command("model.obj"))
     assert outcome.kind == "error", outcome.stderr
     assert outcome.stderr.startswith("model.mtl:2:1:") and "finite" in outcome.stderr
+
+
+@pytest.mark.parametrize("value", ["1e400", "nan", "-1e300"])
+def test_an_untextured_obj_with_a_vertex_of_inf_is_a_located_error(seeds, tmp_path, value):
+    """An OBJ whose MTL is not read (``mtllib /dev/stdin``) is drawn through trimesh, which took
+    ``v 0 1e400 -3`` as inf: the camera and the near clipping made NaN of it (numpy's warnings
+    on the terminal).  Every model's corners are now checked before they are drawn."""
+    seed = _textured_seed(seeds, "obj-mtl", "quads.obj")
+    data = seed.data.replace(b"mtllib quads.mtl", b"mtllib /dev/stdin")
+    seed.write(tmp_path, data.replace(b"v 0 0 -3", f"v 0 {value} -3".encode()))
+    outcome = _run(tmp_path, fuzz_inverse.fuzz_textured.command("quads.obj"))
+    assert outcome.kind == "error", outcome.stderr
+    assert "quads.obj: error: a vertex (0, " in outcome.stderr and "beyond 1e+08" in outcome.stderr
