@@ -27,7 +27,7 @@ import contextlib
 import math
 import os
 from collections.abc import Iterable, Iterator
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
@@ -184,6 +184,45 @@ def _finite(scene: Scene, shown: str) -> Scene:
             )
         )
     return scene
+
+
+def _distinct(scene: Scene) -> Scene:
+    """``scene`` with each triangle that repeats an earlier one exactly (its corners, colour,
+    part, label, image and texture coordinates) kept once: it would cover the same pixels
+    with the same colour.  100,000 copies of one OBJ face drawn through trimesh made 200,000
+    triangles for the numpy rasteriser (5 s).  A weighted sum of each row, sorted, shows
+    first whether any row can repeat (distinct sums: none does), so a model without copies
+    pays one sort of T numbers."""
+    T = len(scene)
+    if T < 2:
+        return scene
+    cols = [
+        scene.triangles.reshape(T, 9),
+        scene.colors.astype(np.float64),
+        scene.part[:, None].astype(np.float64),
+        scene.label[:, None].astype(np.float64),
+    ]
+    if scene.texture is not None and scene.uv is not None:
+        cols += [scene.texture[:, None].astype(np.float64), scene.uv.reshape(T, 6)]
+    rows = np.ascontiguousarray(np.hstack(cols))
+    weights = np.random.default_rng(0).uniform(1.0, 2.0, rows.shape[1])
+    with np.errstate(over="ignore", invalid="ignore"):
+        sums = rows @ weights
+    if len(np.unique(sums)) == T:
+        return scene
+    _, first = np.unique(rows, axis=0, return_index=True)
+    if len(first) == T:
+        return scene
+    keep = np.sort(first)
+    return replace(
+        scene,
+        triangles=scene.triangles[keep],
+        colors=scene.colors[keep],
+        part=scene.part[keep],
+        label=scene.label[keep],
+        texture=None if scene.texture is None else scene.texture[keep],
+        uv=None if scene.uv is None else scene.uv[keep],
+    )
 
 
 def from_trimesh(
@@ -490,11 +529,11 @@ def load_scene(
             )
             return from_result(result)
         if suffix in (".glb", ".gltf"):
-            return _finite(from_gltf(path), str(source))
+            return _distinct(_finite(from_gltf(path), str(source)))
         if suffix in (".obj", ".ply"):
-            return _finite(from_mesh_file(path), str(source))
+            return _distinct(_finite(from_mesh_file(path), str(source)))
         if suffix == ".gml":
-            return _finite(from_citygml(path), str(source))
+            return _distinct(_finite(from_citygml(path), str(source)))
         raise BgrError(
             Diagnostic(
                 str(source),

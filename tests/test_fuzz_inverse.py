@@ -730,3 +730,32 @@ def test_an_untextured_obj_with_a_vertex_of_inf_is_a_located_error(seeds, tmp_pa
     outcome = _run(tmp_path, fuzz_inverse.fuzz_textured.command("quads.obj"))
     assert outcome.kind == "error", outcome.stderr
     assert "quads.obj: error: a vertex (0, " in outcome.stderr and "beyond 1e+08" in outcome.stderr
+
+
+def test_an_obj_naming_its_mtl_100000_times_reads_it_once(seeds, tmp_path, monkeypatch):
+    """``mtllib model.mtl`` repeated 100,000 times read and parsed the MTL 100,000 times (100 s
+    beside other work); each library is now read once."""
+    from bgr.formats import obj_textured
+
+    seed = _textured_seed(seeds, "obj-mtl", "model.obj")
+    seed.write(tmp_path, seed.data.replace(b"mtllib model.mtl\n", b"mtllib model.mtl\n" * 100_000))
+    reads = []
+    real = obj_textured._text
+    monkeypatch.setattr(obj_textured, "_text", lambda *a: reads.append(a[2]) or real(*a))
+    mesh = obj_textured.read_obj_textured(tmp_path / "model.obj")
+    assert reads == ["OBJ file", "MTL file"] and len(mesh.materials) == 2
+
+
+def test_an_untextured_obj_face_repeated_100000_times_is_drawn_once(seeds, tmp_path):
+    """The same copies in an OBJ drawn through trimesh (its MTL not read): 200,000 triangles
+    for the rasteriser (5 s); a triangle that repeats an earlier one exactly is drawn once."""
+    from bgr.render.scene import load_scene
+
+    seed = _textured_seed(seeds, "obj-mtl", "quads.obj")
+    face = b"f 5/7/5 6/7/5 7/7/5 8/7/5\n"
+    data = seed.data.replace(b"mtllib quads.mtl", b"mtllib /dev/stdin")
+    seed.write(tmp_path, data.replace(face, face * 100_000))
+    scene = load_scene(tmp_path / "quads.obj")
+    assert len(scene) == 10  # 4 walls and a roof, 2 triangles each
+    mirrored = scene.triangles[:, ::-1]  # the same corners wound the other way: not a copy
+    assert len({t.tobytes() for t in scene.triangles} | {t.tobytes() for t in mirrored}) == 20
