@@ -170,6 +170,11 @@ def _finite(scene: Scene, shown: str) -> Scene:
     camera and the clipping made NaN of it (numpy's warnings on the terminal)."""
     from ..interpreter.limits import MAX_INPUT_COORDINATE
 
+    if scene.triangles.ndim != 3 or scene.triangles.shape[1:] != (3, 3):
+        # trimesh reads an OBJ whose vertices are all 2 numbers as 2D points
+        raise BgrError(
+            Diagnostic(shown, 0, 0, "its vertices are not 3D points (x y z)", "write v x y z")
+        )
     corners = scene.triangles.reshape(-1, 3)
     bad = ~(np.abs(corners) <= MAX_INPUT_COORDINATE).all(axis=1)
     if bad.any():

@@ -759,3 +759,15 @@ def test_an_untextured_obj_face_repeated_100000_times_is_drawn_once(seeds, tmp_p
     assert len(scene) == 10  # 4 walls and a roof, 2 triangles each
     mirrored = scene.triangles[:, ::-1]  # the same corners wound the other way: not a copy
     assert len({t.tobytes() for t in scene.triangles} | {t.tobytes() for t in mirrored}) == 20
+
+
+def test_an_untextured_obj_read_as_2d_points_is_a_located_error(seeds, tmp_path):
+    """An OBJ whose MTL is not read and one of whose vertices is 2 numbers (``v 4 0``) came
+    back from trimesh as 2D points, which the copy check reshaped as 3D (an internal error,
+    found by the long run); such a model is now an error naming the file."""
+    seed = _textured_seed(seeds, "obj-mtl", "quads.obj")
+    data = seed.data.replace(b"mtllib quads.mtl", b"mqllib quads.mtl")
+    seed.write(tmp_path, data.replace(b"v 4 0 0\n", b"v 4 0 \n"))
+    outcome = _run(tmp_path, fuzz_inverse.fuzz_textured.command("quads.obj"))
+    assert outcome.kind == "error", outcome.stderr
+    assert outcome.stderr.startswith("quads.obj: error: its vertices are not 3D points")
