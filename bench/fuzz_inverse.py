@@ -37,11 +37,12 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
+import fuzz_textured  # noqa: E402
 from fuzz_mutations import mutant  # noqa: E402
 
 ROOT = Path(__file__).resolve().parent.parent
 SHARED = ROOT.parent / "shared" / "data" / "cities"
-SURFACES = ("obj", "ply", "gltf", "glb", "cityjson", "boxes", "captured")
+SURFACES = ("obj", "ply", "gltf", "glb", "cityjson", "boxes", "captured", *fuzz_textured.SURFACES)
 LIMIT_BYTES = 2 << 30  # RLIMIT_AS of a case
 TIMEOUT_S = 10.0
 
@@ -51,7 +52,14 @@ class Seed:
     surface: str
     name: str  # the file name the case is written as
     data: bytes
-    extra: dict[str, bytes]  # other files beside it (a glTF's .bin)
+    extra: dict[str, bytes]  # other files beside it (a glTF's .bin, images), by relative path
+
+    def write(self, folder: Path, data: bytes | None = None) -> None:
+        """The seed's files (its model replaced by ``data``) written in ``folder``."""
+        (folder / self.name).write_bytes(self.data if data is None else data)
+        for name, extra in self.extra.items():
+            (folder / name).parent.mkdir(parents=True, exist_ok=True)
+            (folder / name).write_bytes(extra)
 
 
 # ---------------------------------------------------------------- seeds
@@ -190,6 +198,7 @@ def build_seeds(tmp: Path) -> dict[str, list[Seed]]:
         seeds["boxes"].append(Seed("boxes", path.name, path.read_bytes(), {}))
     for path in sorted((ROOT / "examples/captured").glob("*.json")):
         seeds["captured"].append(Seed("captured", path.name, path.read_bytes(), {}))
+    seeds.update(fuzz_textured.build_seeds(tmp, Seed))
     return seeds
 
 
@@ -198,6 +207,8 @@ _PY_WARNING = re.compile(r"\.py:\d+: \w*Warning")  # a Python warning leaked to 
 
 def command(surface: str, name: str, rng: random.Random) -> list[str]:
     """The bgr command of a case, run in the case's folder."""
+    if surface in fuzz_textured.SURFACES:
+        return fuzz_textured.command(name)
     if surface == "boxes":
         if rng.random() < 0.5:
             return ["retarget", name, "--size", rng.choice(("12,9,30", "3,3,3", "40,2,8")),
@@ -242,7 +253,9 @@ def _child(argv: list[str], folder: Path, limit_bytes: int) -> None:
         signal.signal(signal.SIGINT, signal.SIG_DFL)
         _print_warnings()
         code = main(argv)
-        if code == 0:
+        if code == 0 and argv[0] == "render":
+            code = _check_png(Path("out.png"), fuzz_textured.SIZE)
+        elif code == 0:
             code = _check_output(Path("out.bgr"))
     except SystemExit as e:
         code = e.code if isinstance(e.code, int) else 2
@@ -287,6 +300,24 @@ def _check_output(path: Path) -> int:
     return 0
 
 
+def _check_png(path: Path, size: tuple[int, int]) -> int:
+    """0 when ``bgr render`` (exit 0) wrote a readable PNG of ``size``, else a failure's status
+    with what is wrong on standard error."""
+    from PIL import Image
+
+    try:
+        with Image.open(path) as image:
+            image.load()
+            found = (image.format, image.size)
+    except Exception as exc:  # noqa: BLE001  (whatever it is, the output is not a PNG)
+        print(f"unreadable output: {type(exc).__name__}: {exc}", file=sys.stderr)
+        return 74
+    if found != ("PNG", size):
+        print(f"wrong output: {found}, expected a PNG of {size}", file=sys.stderr)
+        return 74
+    return 0
+
+
 def _print_warnings() -> None:
     """Warnings to standard error, as a user sees them, even in a child of pytest (which
     records them): a leaked numpy or trimesh warning is a finding."""
@@ -301,6 +332,8 @@ def _print_warnings() -> None:
 def run_case(argv: list[str], folder: Path, timeout: float = TIMEOUT_S,
              limit_bytes: int = LIMIT_BYTES) -> Outcome:  # fmt: skip
     """Fork a child that runs ``bgr argv`` in ``folder``; classify what it did."""
+    # the files of the case (a model and the files beside it: an MTL, images) may be named
+    beside = [str(p.relative_to(folder)) for p in folder.rglob("*") if p.is_file()]
     start = time.perf_counter()
     pid = os.fork()
     if pid == 0:
@@ -318,7 +351,8 @@ def run_case(argv: list[str], folder: Path, timeout: float = TIMEOUT_S,
     left = [p.name for p in folder.rglob("*.tmp")]
     if left:
         return Outcome("left temporaries", seconds, stderr)
-    if "Traceback" in stderr or "internal error" in stderr:
+    head = whole[:4000]  # a long message may push "internal error" out of the tail
+    if any(word in text for word in ("Traceback", "internal error") for text in (head, stderr)):
         return Outcome("internal", seconds, stderr)
     if _PY_WARNING.search(stderr):
         return Outcome("python warning", seconds, stderr)
@@ -327,8 +361,9 @@ def run_case(argv: list[str], folder: Path, timeout: float = TIMEOUT_S,
     if code == 0:
         return Outcome("success", seconds, stderr)
     if code == 1 and stderr.strip():
-        # located: the message starts with the input or the output file (FILE:LINE:COL: ...)
-        files = [argv[1], *(argv[k + 1] for k, a in enumerate(argv[:-1]) if a == "-o")]
+        # located: the message starts with the input or the output file (FILE:LINE:COL: ...),
+        # or a file beside the input that it names (model.mtl:3:1: ...)
+        files = [argv[1], *(argv[k + 1] for k, a in enumerate(argv[:-1]) if a == "-o"), *beside]
         located = whole.lstrip().startswith(tuple(files)) if len(argv) > 1 else True
         return Outcome("error" if located else "unlocated error", seconds, stderr)
     return Outcome(f"exit {code}", seconds, stderr)
@@ -366,10 +401,12 @@ def run_mutant(
 ) -> Case:
     """A mutant of one of ``seeds`` (drawn by ``rng``) written to ``folder`` and run there."""
     seed = rng.choice(seeds)
-    data = mutant(rng, seed.surface, seed.data)
-    (folder / seed.name).write_bytes(data)
-    for name, extra in seed.extra.items():
-        (folder / name).write_bytes(extra)
+    if seed.surface in fuzz_textured.SURFACES:  # any of its files mutated
+        data, extra = fuzz_textured.mutate_case(rng, seed.surface, seed.name, seed.data, seed.extra)
+        seed = Seed(seed.surface, seed.name, seed.data, extra)
+    else:
+        data = mutant(rng, seed.surface, seed.data)
+    seed.write(folder, data)
     argv = command(seed.surface, seed.name, rng)
     return seed, data, argv, run_case(argv, folder, timeout)
 
@@ -397,9 +434,7 @@ def _cases(seeds, surfaces, cases, base_seed, part, parts, out: Path, tmp: Path)
                 if outcome.failed:
                     stem = out / "failures" / f"{surface}-{index}"
                     stem.mkdir(parents=True, exist_ok=True)
-                    (stem / seed.name).write_bytes(data)
-                    for name, extra in seed.extra.items():
-                        (stem / name).write_bytes(extra)
+                    seed.write(stem, data)
                     (stem / "case.txt").write_text(
                         f"bgr {' '.join(argv)}\n{outcome.kind} after {outcome.seconds:.1f} s\n"
                         f"{outcome.stderr}"
@@ -448,10 +483,16 @@ def main(argv: list[str] | None = None) -> int:
     out = args.out or Path(tempfile.mkdtemp(prefix="bgr-fuzz-inverse-"))
     out.mkdir(parents=True, exist_ok=True)
     surfaces = args.surface or list(SURFACES)
+    from PIL import Image as _image  # noqa: F401
+    from pyproj import Transformer as _transformer  # noqa: F401
+
     import bgr.cli  # noqa: F401  (imported once, before the forks)
+    from bgr.formats import citygml_read, gltf_textured, obj_textured  # noqa: F401
     from bgr.inverse import schema as _schema  # noqa: F401
     from bgr.inverse.boxes import command as _boxes  # noqa: F401
     from bgr.inverse.city import command as _city  # noqa: F401
+    from bgr.render import scene as _scene  # noqa: F401
+    from bgr.render import textured as _textured  # noqa: F401
 
     with tempfile.TemporaryDirectory() as tmp:
         seeds = build_seeds(Path(tmp))

@@ -321,6 +321,18 @@ def parse_citygml(data: bytes, shown: str) -> RawCity:
         raise BgrError(
             Diagnostic(shown, exc.lineno, exc.offset + 1, f"not well-formed XML: {message}")
         ) from None
+    except (LookupError, ValueError) as exc:  # an encoding expat cannot use ("UTF-3", Shift_JIS)
+        p = state.parser
+        reason = str(exc)[:100].encode("unicode_escape").decode("ascii")
+        raise BgrError(
+            Diagnostic(
+                shown,
+                p.CurrentLineNumber,
+                p.CurrentColumnNumber + 1,
+                f"the XML declaration's encoding cannot be read: {reason}",
+                "save the file as UTF-8 (CityGML files are UTF-8 in practice)",
+            )
+        ) from None
     if state.envelope_crs is not None:
         state.city.crs = state.envelope_crs
     return state.city

@@ -65,13 +65,12 @@ class Material:
         return self.image is not None or self.data is not None
 
     def image_size(self) -> tuple[int, int]:
-        """(width, height) of the image in pixels, from its header (Pillow; read once)."""
+        """(width, height) of the image in pixels, from its header (Pillow; read once);
+        ValueError for one of more than ``bgr.grammar.textures.MAX_IMAGE_PIXELS``."""
         if self._size is None:
-            import io
+            from bgr.grammar.textures import open_image
 
-            from PIL import Image
-
-            with Image.open(io.BytesIO(self.image_bytes())) as im:
+            with open_image(self.image_bytes()) as im:
                 self._size = (int(im.width), int(im.height))
         return self._size
 
@@ -127,8 +126,15 @@ def image_path(folder: Path, uri: str) -> Path:
     name = unquote(uri).replace("\\", "/")
     if not name or name.startswith("/") or _DRIVE.match(name) or "\0" in name:
         raise ValueError("is not a relative path inside the model's folder")
+    if len(name.encode("utf-8", "surrogatepass")) > 4096 or any(
+        len(part.encode("utf-8", "surrogatepass")) > 255 for part in name.split("/")
+    ):  # past PATH_MAX or NAME_MAX: stat() would raise ENAMETOOLONG
+        raise ValueError("cannot be a file name (File name too long)")
     root = resolved(folder)
-    target = resolved(root / name)
+    try:
+        target = resolved(root / name)
+    except OSError as exc:  # a name of 100,000 characters: ENAMETOOLONG
+        raise ValueError(f"cannot be a file name ({exc.strerror or exc})") from None
     if not target.is_relative_to(root):
         raise ValueError("lies outside the model's folder")
     return target

@@ -10,6 +10,7 @@ one), so a missing or broken image is a located error, never a traceback or a bl
 from __future__ import annotations
 
 import io
+import re
 from collections.abc import Iterable
 from dataclasses import dataclass
 from pathlib import Path
@@ -19,6 +20,11 @@ from .paths import ALLOW_HINT, check_input, read_input, within
 
 MIME = {"PNG": "image/png", "JPEG": "image/jpeg"}
 MAX_IMAGE_BYTES = 64 << 20  # a texture larger than this is a mistake, not a façade
+# pixels of one texture image, read from its header before it is decoded: 8192 x 4096.  A PNG
+# of 18 KB may claim 12,000 x 12,000 pixels (432 MB as RGB, and the renderer's mipmaps in
+# linear light eight bytes a channel on top); below Pillow's own decompression-bomb limit
+# (89,478,485, a warning; twice that, an error), so that limit never speaks first
+MAX_IMAGE_PIXELS = 8192 * 4096
 
 
 class TextureError(ValueError):
@@ -88,9 +94,7 @@ def decode_image(data: bytes, key: str, shown: str) -> Image:
     """An :class:`Image` of PNG or JPEG bytes (``key``: what makes it distinct, a resolved path
     or a path and a name inside a model file); :class:`TextureError` for anything else."""
     try:
-        from PIL import Image as PILImage
-
-        with PILImage.open(io.BytesIO(data)) as img:
+        with open_image(data) as img:
             kind = img.format or ""
             img.load()  # decodes it: a truncated or corrupt file fails here, not in a viewer
             width, height = img.size
@@ -106,6 +110,34 @@ def decode_image(data: bytes, key: str, shown: str) -> Image:
             "textures are PNG or JPEG files (what glTF readers take); convert it",
         )
     return Image(key, data, MIME[kind], int(width), int(height), bool(alpha))
+
+
+def open_image(data: bytes):
+    """The Pillow image of ``data``, opened (its header read) but not decoded; ValueError saying
+    why when it claims more than MAX_IMAGE_PIXELS pixels.  What Pillow raises for bytes that
+    are no image reaches the caller.  Pillow's decompression-bomb warning is silenced here:
+    this limit, lower, is the one that holds."""
+    import warnings
+
+    from PIL import Image as PILImage
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", PILImage.DecompressionBombWarning)
+        try:
+            img = PILImage.open(io.BytesIO(data))
+        except PILImage.DecompressionBombError as exc:  # twice Pillow's limit: its own error
+            claimed = re.search(r"\((\d+) pixels\)", str(exc))
+            count = f"{int(claimed[1]):,}" if claimed else "more"
+            raise ValueError(
+                f"it claims {count} pixels, more than {MAX_IMAGE_PIXELS:,} (8192 x 4096)"
+            ) from None
+    width, height = img.size
+    if width * height > MAX_IMAGE_PIXELS:
+        img.close()
+        raise ValueError(
+            f"it claims {width:,} x {height:,} pixels, more than {MAX_IMAGE_PIXELS:,} (8192 x 4096)"
+        )
+    return img
 
 
 def load(module_path: str, roots: Iterable[Path], text: str, folder: Path | None = None) -> Image:

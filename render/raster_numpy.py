@@ -104,6 +104,19 @@ def clip_near(cam: np.ndarray, near: float) -> tuple[np.ndarray, np.ndarray]:
     return np.concatenate(out), np.concatenate(source)
 
 
+def _merge(zbuf: np.ndarray, ids: np.ndarray, pix: np.ndarray, inv: np.ndarray, tri: np.ndarray):
+    """The z-test of one block of fragments folded into the buffers: per pixel the largest
+    inverse depth, and of the fragments at it the lowest triangle index -- what one test of all
+    fragments at once gives, whatever the blocks.  Fragments were once kept until the end:
+    100,000 copies of one face over a 64 x 48 image made 10^8 of them, 1.6 GB."""
+    touched = np.unique(pix)
+    before = zbuf[touched]
+    np.maximum.at(zbuf, pix, inv)
+    ids[touched[zbuf[touched] > before]] = np.iinfo(np.int64).max  # nearer now: earlier lose
+    win = inv == zbuf[pix]
+    np.minimum.at(ids, pix[win], tri[win])
+
+
 def rasterise(triangles: np.ndarray, camera: Camera) -> Frame:
     """Depth and triangle-index buffers of world ``triangles`` (T, 3, 3) seen by ``camera``."""
     W, H = camera.size
@@ -164,7 +177,8 @@ def rasterise(triangles: np.ndarray, camera: Camera) -> Frame:
     key = wc * (H + 1) + hc
     order = np.argsort(key, kind="stable")
     cuts = np.flatnonzero(np.diff(key[order])) + 1
-    pixels, inverse, tris = [], [], []
+    zbuf = np.zeros(W * H)
+    ids = np.full(W * H, np.iinfo(np.int64).max)
     for group in np.split(order, cuts):
         wb, hb = int(wc[group[0]]), int(hc[group[0]])
         step = max(1, CHUNK // (wb * hb))
@@ -182,20 +196,13 @@ def rasterise(triangles: np.ndarray, camera: Camera) -> Frame:
             if not len(n):
                 continue
             t = sel[n]
-            pixels.append((j0[t] + jj) * W + (i0[t] + ii))
-            inverse.append(ZA[t] + ZX[t] * ii + ZY[t] * jj)
-            tris.append(source[t])
-    if not pixels:
-        return frame
-    pix = np.concatenate(pixels)
-    inv = np.concatenate(inverse)
-    tri = np.concatenate(tris).astype(np.int64)
-
-    zbuf = np.zeros(W * H)
-    np.maximum.at(zbuf, pix, inv)
-    win = inv == zbuf[pix]
-    ids = np.full(W * H, np.iinfo(np.int64).max)
-    np.minimum.at(ids, pix[win], tri[win])
+            _merge(
+                zbuf,
+                ids,
+                (j0[t] + jj) * W + (i0[t] + ii),
+                ZA[t] + ZX[t] * ii + ZY[t] * jj,
+                source[t].astype(np.int64),
+            )
     covered = zbuf > 0
     frame.triangle.reshape(-1)[covered] = ids[covered]
     frame.depth.reshape(-1)[covered] = 1.0 / zbuf[covered]

@@ -17,13 +17,12 @@ corner, v growing upwards (CGA, OBJ, CityGML); the glTF writer's flipped v is un
 
 from __future__ import annotations
 
-import io
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from ..grammar.errors import Diagnostic
+from ..grammar.errors import BgrError, Diagnostic
 
 if TYPE_CHECKING:
     from .scene import Scene
@@ -45,10 +44,11 @@ class Texture:
 
 def decode(data: bytes) -> np.ndarray:
     """(H, W, 3) uint8 RGB of a PNG or JPEG file's bytes (an alpha channel is dropped: the
-    renderer draws opaque surfaces).  Raises what Pillow raises for a broken image."""
-    from PIL import Image
+    renderer draws opaque surfaces).  Raises what Pillow raises for a broken image, and
+    ValueError for one of more than MAX_IMAGE_PIXELS (its header is read first)."""
+    from ..grammar.textures import open_image
 
-    with Image.open(io.BytesIO(data)) as im:
+    with open_image(data) as im:
         return np.ascontiguousarray(np.asarray(im.convert("RGB"), dtype=np.uint8))
 
 
@@ -118,7 +118,9 @@ def local_frame(vertices: np.ndarray, up: str, crs: str | None) -> np.ndarray:
     does not know) is moved to its centre and turned to y up.  A z-up model in a geographic CRS
     (degrees, height in metres: PLATEAU's EPSG:6697 is latitude, longitude, height) is projected
     with pyproj onto a transverse Mercator centred there on the CRS's own ellipsoid: a local
-    metric frame whose scale error over a city block is under 10^-8; heights are kept."""
+    metric frame whose scale error over a city block is under 10^-8; heights are kept.
+    ValueError, saying why, for degrees outside -90..90 / -180..180 or a model too large to
+    project (pyproj refused such a centre with a CRSError, or made infinite coordinates)."""
     v = np.asarray(vertices, dtype=np.float64).reshape(-1, 3)
     if up != "z" or not len(v):
         return v
@@ -130,6 +132,11 @@ def local_frame(vertices: np.ndarray, up: str, crs: str | None) -> np.ndarray:
         from pyproj import CRS, Transformer
 
         source, lon, lat = geographic
+        if not ((np.abs(v[:, lat]) <= 90.0).all() and (np.abs(v[:, lon]) <= 180.0).all()):
+            raise ValueError(
+                f"coordinates outside latitude -90..90 or longitude -180..180, but the CRS "
+                f"{str(crs)[:100]!r} is geographic (degrees)"
+            )
         lat0, lon0 = float(centre[lat]), float(centre[lon])
         local = CRS.from_proj4(
             f"+proj=tmerc +lat_0={lat0!r} +lon_0={lon0!r} +k=1 +x_0=0 +y_0=0 "
@@ -139,6 +146,11 @@ def local_frame(vertices: np.ndarray, up: str, crs: str | None) -> np.ndarray:
         to_local = Transformer.from_crs(source, local, always_xy=True)
         east, north = to_local.transform(v[:, lon], v[:, lat])
         east, north = np.asarray(east, dtype=np.float64), np.asarray(north, dtype=np.float64)
+        if not (np.isfinite(east).all() and np.isfinite(north).all()):
+            raise ValueError(
+                f"the model spans too much of the globe to be drawn on a local map of its "
+                f"CRS {str(crs)[:100]!r}"
+            )
     return np.column_stack([east, v[:, 2], -north])
 
 
@@ -162,7 +174,7 @@ def mesh_textures(mesh, shown: str) -> tuple[np.ndarray, list, list[Diagnostic]]
                     0,
                     0,
                     f"texture image of material '{material.name[:200]}' cannot be read "
-                    f"({type(exc).__name__}): its faces are drawn in their colour",
+                    f"({_why(exc)}): its faces are drawn in their colour",
                     severity="warning",
                 )
             )
@@ -171,6 +183,14 @@ def mesh_textures(mesh, shown: str) -> tuple[np.ndarray, list, list[Diagnostic]]
         index[k] = len(textures)
         textures.append(Texture(rgb, wrap, material.name))
     return index[mesh.material], textures, warnings
+
+
+def _why(exc: Exception) -> str:
+    """Why an image cannot be read, in a few words: our own ValueError's message (a pixel
+    limit), else the exception's type (Pillow's messages quote bytes of the file)."""
+    if type(exc) is ValueError:
+        return str(exc)[:200]
+    return type(exc).__name__
 
 
 def from_textured_mesh(mesh, shown: str = "") -> Scene:
@@ -183,7 +203,18 @@ def from_textured_mesh(mesh, shown: str = "") -> Scene:
     parts are the polygon or primitive each triangle comes from."""
     from .scene import NO_LABEL, Scene, labels_index
 
-    vertices = local_frame(mesh.vertices, mesh.up, mesh.crs)
+    try:
+        vertices = local_frame(mesh.vertices, mesh.up, mesh.crs)
+    except ValueError as exc:
+        raise BgrError(
+            Diagnostic(
+                shown or mesh.source,
+                0,
+                0,
+                f"cannot be drawn: {exc}",
+                "check the gml:Envelope's srsName against the coordinates",
+            )
+        ) from None
     faces = np.asarray(mesh.faces, dtype=np.int64).reshape(-1, 3)
     rgb = [np.rint(np.clip(m.color[:3], 0.0, 1.0) * 255.0) for m in mesh.materials]
     table = np.array([*rgb, (200, 200, 200)], dtype=np.uint8).reshape(-1, 3)

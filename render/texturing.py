@@ -132,11 +132,25 @@ def _to_srgb8(c: np.ndarray) -> np.ndarray:
     return np.rint(s * 255.0).astype(np.uint8)
 
 
+def _texels(t: np.ndarray, n: int, wrap: str) -> np.ndarray:
+    """Texel coordinates ``t`` brought into a range whose floor fits int64 and names the same
+    texels after :func:`_wrap`: NaN and infinities to 0, then one period (n, or 2n mirrored) or
+    clamped to -1..n.  A model's UVs may be 1e30 (a glTF buffer holds any float): cast as
+    they were, they overflowed int64 (numpy's "invalid value encountered in cast")."""
+    t = np.nan_to_num(t, nan=0.0, posinf=0.0, neginf=0.0)
+    if wrap == "wrap":
+        return np.mod(t, n)
+    if wrap == "mirror":
+        return np.mod(t, 2 * n)
+    return np.clip(t, -1.0, float(n))
+
+
 def _bilinear(rgb: np.ndarray, uv: np.ndarray, wrap: str) -> np.ndarray:
     h, w = rgb.shape[:2]
     # texel centres at (k + 0.5) / size; rows counted from the top
-    x = np.nan_to_num(uv[:, 0] * w - 0.5, nan=0.0, posinf=0.0, neginf=0.0)
-    y = np.nan_to_num((1.0 - uv[:, 1]) * h - 0.5, nan=0.0, posinf=0.0, neginf=0.0)
+    with np.errstate(over="ignore", invalid="ignore"):  # 1e308 * w: inf, made 0 by _texels
+        x = _texels(uv[:, 0] * w - 0.5, w, wrap)
+        y = _texels((1.0 - uv[:, 1]) * h - 0.5, h, wrap)
     x0, y0 = np.floor(x), np.floor(y)
     fx, fy = (x - x0)[:, None], (y - y0)[:, None]
     i0, j0 = x0.astype(np.int64), y0.astype(np.int64)
@@ -156,16 +170,18 @@ def sample(
     rgb = texture.rgb
     h, w = rgb.shape[:2]
     if filter == "nearest":
-        x = np.nan_to_num(uv[:, 0] * w, nan=0.0, posinf=0.0, neginf=0.0)
-        y = np.nan_to_num((1.0 - uv[:, 1]) * h, nan=0.0, posinf=0.0, neginf=0.0)
+        with np.errstate(over="ignore", invalid="ignore"):
+            x = _texels(uv[:, 0] * w, w, texture.wrap)
+            y = _texels((1.0 - uv[:, 1]) * h, h, texture.wrap)
         i = _wrap(np.floor(x).astype(np.int64), w, texture.wrap)
         j = _wrap(np.floor(y).astype(np.int64), h, texture.wrap)
         return _LINEAR[rgb[j, i]]
     if footprint is None:
         return _bilinear(rgb, uv, texture.wrap)
     # texels per pixel: the longer of the two steps, measured in level-0 texels
-    steps = footprint * np.array([w, h], dtype=np.float64)
-    rho = np.sqrt(np.maximum((steps[:, 0] ** 2).sum(axis=1), (steps[:, 1] ** 2).sum(axis=1)))
+    with np.errstate(over="ignore", invalid="ignore"):  # inf and nan: level 0 below
+        steps = footprint * np.array([w, h], dtype=np.float64)
+        rho = np.sqrt(np.maximum((steps[:, 0] ** 2).sum(axis=1), (steps[:, 1] ** 2).sum(axis=1)))
     levels = mipmaps(texture)
     with np.errstate(divide="ignore", invalid="ignore"):
         level = np.floor(np.log2(rho) + 0.5)
@@ -196,7 +212,9 @@ def textured_pixels(
     if not len(pixels):
         return empty
     tri = flat[pixels].astype(np.int64)
-    uv, footprint = pixel_uv(frame, scene, pixels, tri)
+    # UVs of 1e308 (any float a model holds) overflow to inf and nan here: sample() takes them
+    with np.errstate(over="ignore", invalid="ignore"):
+        uv, footprint = pixel_uv(frame, scene, pixels, tri)
     colour = np.empty((len(pixels), 3))
     order = np.argsort(which, kind="stable")
     cuts = np.flatnonzero(np.diff(which[order])) + 1
