@@ -365,3 +365,43 @@ def test_plateau_walls_get_their_photographs(tmp_path: Path) -> None:
     )
     assert right_err < 6  # of 255 (measured 1.8): half a pixel's shift on a photograph
     assert mirror_err > 2 * right_err and flip_err > 2 * right_err  # measured 10.8 and 13.4
+
+
+def test_a_face_whose_one_pixel_no_projection_covers_takes_the_sources_colour(
+    tmp_path: Path,
+) -> None:
+    img = np.full((30, 40, 3), (10, 200, 30), dtype=np.uint8)
+    mesh = quad_mesh(
+        [((4.0, 0.0), (2.4, 0.0), 0.0, 3.0, 0, None)],  # the left 40 % of the front wall
+        [Material("m", image=save(img, tmp_path / "f.png"))],
+    )
+    (f,) = run(mesh, [face((4.0, 0.0), (0.0, 0.0))], texels_per_unit=0.1)  # 1 x 1: its centre
+    assert f.texture is not None and f.texture.shape == (1, 1, 3)  # is at 50 %, uncovered
+    assert tuple(f.texture[0, 0]) == (10, 200, 30) and f.color == (10, 200, 30)
+
+
+def test_where_two_projections_of_one_image_overlap_the_one_in_front_shows(tmp_path: Path) -> None:
+    img = np.zeros((30, 40, 3), dtype=np.uint8)
+    img[:, :20], img[:, 20:] = RED, BLUE
+    png = save(img, tmp_path / "f.png")
+    on_plane = ((4.0, 0.0), (0.0, 0.0), 0.0, 3.0, 0, (0.0, 0.0, 0.5, 1.0))  # the red half
+    in_front = ((4.0, -0.01), (0.0, -0.01), 0.0, 3.0, 0, (0.5, 0.0, 1.0, 1.0))  # the blue half
+    for quads in ([on_plane, in_front], [in_front, on_plane]):  # whatever the file's order
+        (f,) = run(quad_mesh(quads, [Material("m", image=png)]), [face((4.0, 0.0), (0.0, 0.0))])
+        assert f.texture is not None and (f.texture[:, 1:] == BLUE).all()
+        # the first column samples within half a texel of the red half: bilinear blends it in
+        assert (f.texture[:, 0, 2] > 200).all()
+
+
+@pytest.mark.parametrize(("share", "textured"), [(0.01, False), (0.03, True)])
+def test_a_sliver_below_min_cover_leaves_a_face_untextured(
+    tmp_path: Path, share: float, textured: bool
+) -> None:
+    img = np.full((30, 40, 3), RED, dtype=np.uint8)
+    edge = 4.0 - 4.0 * share  # the source covers the face's left `share` seen from outside
+    mesh = quad_mesh(
+        [((4.0, 0.0), (edge, 0.0), 0.0, 3.0, 0, None)],
+        [Material("m", image=save(img, tmp_path / "f.png"))],
+    )
+    (f,) = run(mesh, [face((4.0, 0.0), (0.0, 0.0))], texels_per_unit=10)
+    assert (f.texture is not None) == textured
