@@ -405,3 +405,37 @@ def test_a_sliver_below_min_cover_leaves_a_face_untextured(
     )
     (f,) = run(mesh, [face((4.0, 0.0), (0.0, 0.0))], texels_per_unit=10)
     assert (f.texture is not None) == textured
+
+
+def test_a_face_coarser_than_its_source_averages_rather_than_aliases(tmp_path: Path) -> None:
+    img = np.zeros((30, 40, 3), dtype=np.uint8)
+    img[:, 1::2] = 255  # one-texel black and white stripes: 10 texels a unit
+    mesh = quad_mesh(
+        [((4.0, 0.0), (0.0, 0.0), 0.0, 3.0, 0, None)],
+        [Material("m", image=save(img, tmp_path / "f.png"))],
+    )
+    # 3 pixels a unit: a pixel spans 3.3 texels; point or bilinear samples would show stripes
+    # of varying grey, the area they cover averages 127.5
+    (f,) = run(mesh, [face((4.0, 0.0), (0.0, 0.0))], texels_per_unit=3)
+    assert f.texture is not None and f.texture.shape == (9, 12, 3)
+    assert np.abs(f.texture.astype(int) - 127.5).max() <= 1
+
+
+def test_only_the_selected_triangles_project(tmp_path: Path) -> None:
+    red = np.full((30, 40, 3), RED, dtype=np.uint8)
+    blue = np.full((60, 80, 3), BLUE, dtype=np.uint8)
+    mats = [
+        Material("ours", image=save(red, tmp_path / "r.png")),
+        Material("theirs", image=save(blue, tmp_path / "b.png")),
+    ]
+    # the neighbour's wall is coplanar, finer and covers the whole face; ours only 60 %
+    mesh = quad_mesh(
+        [
+            ((4.0, 0.0), (1.6, 0.0), 0.0, 3.0, 0, None),
+            ((4.0, 0.0), (0.0, 0.0), 0.0, 3.0, 1, None),
+        ],
+        mats,
+    )
+    (f,) = [face((4.0, 0.0), (0.0, 0.0))]
+    face_textures(mesh, mesh.vertices, np.array([True, True, False, False]), [f])
+    assert f.texture is not None and (f.texture == RED).all()

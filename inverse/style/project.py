@@ -138,26 +138,39 @@ class _Triangles:
 
 
 class _Images:
-    """Each material's image as an (h, w, 3) float32 array, decoded on first use."""
+    """Each material's image, decoded on first use, and its box-filtered reductions by powers of
+    two: a face sampled more coarsely than its source would otherwise alias (every third window
+    mullion, stripes of a fine brick pattern), as a texture read without mipmaps does."""
 
     def __init__(self, mesh: TexturedMesh) -> None:
         self.mesh = mesh
-        self.cache: dict[int, np.ndarray] = {}
+        self.cache: dict[tuple[int, int], np.ndarray] = {}
 
-    def __call__(self, material: int) -> np.ndarray:
-        if material not in self.cache:
-            from bgr.grammar.textures import open_image
+    def __call__(self, material: int, factor: int = 1) -> np.ndarray:
+        """(h, w, 3) float32: the image, reduced ``factor`` times in each direction."""
+        if (material, 1) not in self.cache:
+            self.cache[material, 1] = self._decode(material)
+        if (material, factor) not in self.cache:
+            from PIL import Image
 
-            mat = self.mesh.materials[material]
-            try:
-                with open_image(mat.image_bytes()) as im:
-                    self.cache[material] = np.asarray(im.convert("RGB"), dtype=np.float32)
-            except Exception as exc:  # Pillow raises many kinds for bytes that are no image
-                where = str(mat.image) if mat.image is not None else f"material {mat.name!r}"
-                raise BgrError(
-                    f"texture image {where} cannot be read: {exc}", self.mesh.source
-                ) from None
-        return self.cache[material]
+            full = self.cache[material, 1]
+            size = (max(1, round(full.shape[1] / factor)), max(1, round(full.shape[0] / factor)))
+            small = Image.fromarray(full.astype(np.uint8)).resize(size, Image.Resampling.BOX)
+            self.cache[material, factor] = np.asarray(small, dtype=np.float32)
+        return self.cache[material, factor]
+
+    def _decode(self, material: int) -> np.ndarray:
+        from bgr.grammar.textures import open_image
+
+        mat = self.mesh.materials[material]
+        try:
+            with open_image(mat.image_bytes()) as im:
+                return np.asarray(im.convert("RGB"), dtype=np.float32)
+        except Exception as exc:  # Pillow raises many kinds for bytes that are no image
+            where = str(mat.image) if mat.image is not None else f"material {mat.name!r}"
+            raise BgrError(
+                f"texture image {where} cannot be read: {exc}", self.mesh.source
+            ) from None
 
 
 def _project_face(
@@ -180,9 +193,10 @@ def _project_face(
         return
     mine = tris.material[index] == winner
     index, proj, front = index[mine], proj[mine], front[mine]
-    image = images(winner)
-    density = texels_per_unit or _density(proj, tris.uv[index], image.shape)
-    cols, rows = _grid(width, height, density, max_size)
+    source = _density(proj, tris.uv[index], images(winner).shape)
+    cols, rows = _grid(width, height, texels_per_unit or source, max_size)
+    step = source * width / cols  # source texels a face pixel spans
+    image = images(winner, 2 ** int(np.log2(step)) if step >= 2 else 1)
     uv, covered = _raster(proj, tris.uv[index], np.argsort(front, kind="stable"), face, cols, rows)
     wrap = images.mesh.materials[winner].wrap
     texture = np.empty((rows, cols, 3), dtype=np.float32)
