@@ -13,8 +13,14 @@ from the face's left end seen from outside) and ``y`` (height).  They are groupe
 polygon areas, overlaps counted once).  Its triangles are rasterised onto a pixel grid of the face
 and each pixel centre samples the image at its barycentric UV: the face's rectified texture.
 
-The paper does not say how to rasterise, how fine, or what a pixel no projection covers shows;
-those choices are documented where they are made.
+The paper does not say how to rasterise, how fine, or what a pixel no projection covers shows.
+Chosen here, each documented where it is made: the grid keeps the winning source's own texel
+density (capped at ``max_size`` a side); "interpolated" is barycentric UVs a pixel and bilinear
+texels, from a box-filtered reduction of the image when a pixel spans two or more texels; where
+projections of the winning image overlap, the one in front shows; pixels none covers take the
+mean colour of the covered ones (the remeshed face is a bounding shape, so a stepped wall leaves
+corners uncovered).  The paper's models carry one photograph a wall; PLATEAU's one atlas a
+building, which is one "texture" here, so its walls never compete.
 """
 
 from __future__ import annotations
