@@ -247,6 +247,21 @@ def test_synthetic_facade_rules_within_2_pixels() -> None:
     assert v_rule.sections[1][1] == pytest.approx(40, abs=2)  # image order: the top window first
 
 
+def test_window_size_merges_a_window_cut_by_its_muntin() -> None:
+    img = _facade()
+    img[:, 368:371] = (205, 185, 160)  # a wall-coloured muntin down the third window (330-400)
+    # the muntin's columns vary no more than the wall's: the labelling cuts that window in two
+    # halves of 38 and 29 pixels; the objective window size (in the caller's unit: 600 px make
+    # 6 m) decides whether they are fragments of one window (< 0.5 window) or windows
+    whole = detect_rule(img, "x", 6.0, window=0.65)
+    assert whole.insertable == pytest.approx((0.6, 0.6, 0.7, 0.6), abs=0.02)
+    cut = detect_rule(img, "x", 6.0, window=0.2)
+    assert cut.insertable == pytest.approx((0.6, 0.6, 0.38, 0.29, 0.6), abs=0.02)
+    assert detect_rule(img, "x", 6.0).insertable == pytest.approx(whole.insertable)  # default
+    with pytest.raises(ValueError):
+        detect_rule(img, "x", 6.0, window=math.nan)
+
+
 def test_signals_refuse_bad_images() -> None:
     with pytest.raises(ValueError):
         variance_signal(np.zeros((4, 4, 3), np.uint8), "z")

@@ -67,9 +67,9 @@ def kmeans_1d(signal: np.ndarray, iterations: int = 100) -> tuple[float, float]:
         raise ValueError("k-means of an empty signal")
     mu = np.array([values.min(), values.max()])
     assign = np.zeros(values.size, dtype=bool)
-    for _ in range(iterations):
+    for step in range(iterations):
         new = np.abs(values - mu[1]) < np.abs(values - mu[0])
-        if _ and np.array_equal(new, assign):
+        if step and np.array_equal(new, assign):
             break
         assign = new
         if assign.any():
