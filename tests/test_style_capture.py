@@ -256,3 +256,29 @@ def test_plateau_buildings_capture():
     front, right, back, left = (wall for wall in block.walls)
     assert all(abs(f.start[1] - f.end[1]) < 1e-3 * f.width for f in front + back)
     assert all(abs(f.start[0] - f.end[0]) < 1e-3 * f.width for f in right + left)
+
+
+def test_coordinates_that_do_not_project_are_a_located_error():
+    mesh, _ = _stepped()
+    mesh.crs = "EPSG:4326"  # latitude, longitude: 100 and 200 degrees are nowhere
+    with pytest.raises(BgrError, match="not finite metres") as info:
+        capture_geometry(mesh, None)
+    assert info.value.diagnostics[0].path == "mem.gml"
+
+
+def test_a_geographic_building_is_measured_in_metres():
+    """EPSG:6697 (latitude, longitude, height): a box 0.0002 degrees of latitude by 0.0001 of
+    longitude at 35.5 N, from 3 to 13 m.  By the ellipsoid's series, a degree of latitude there
+    is 110,949.8 m and one of longitude 90,729.9 m: 22.190 m by 9.073 m, times UTM zone 54's
+    scale 0.99974 at 139.8 E."""
+    v, f = _box((0.0002, 0.0001, 10.0), (35.5001, 139.80005, 8.0))
+    mesh = _mesh([(v, f)])
+    mesh.crs = "http://www.opengis.net/def/crs/EPSG/0/6697"
+    capture, frame = capture_geometry(mesh, None)
+    assert frame.utm == "EPSG:32654" and frame.scale == pytest.approx(10.0)
+    (block,) = capture.blocks
+    width, height, depth = block.size
+    assert width * 10 == pytest.approx(22.190 * 0.99974, rel=3e-4)  # the long side is x
+    assert depth * 10 == pytest.approx(9.073 * 0.99974, rel=3e-4)
+    assert height == pytest.approx(1.0)
+    np.testing.assert_allclose(frame.unapply(frame.apply(v)), v, rtol=0, atol=1e-9)

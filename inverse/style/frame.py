@@ -112,6 +112,17 @@ def standard_frame(mesh: TexturedMesh, faces: np.ndarray) -> Frame:
     used = np.unique(tris)
     metric = np.zeros((len(mesh.vertices), 3))
     metric[used] = frame.metric(mesh.vertices[used])
+    if not np.isfinite(metric[used]).all():
+        raise BgrError(
+            Diagnostic(
+                shown,
+                0,
+                0,
+                "the building has coordinates that are not finite metres"
+                + (f" once projected from {source[:200]} to {utm}" if utm else ""),
+                "check the model's CRS and coordinates",
+            )
+        )
     corners = metric[tris]  # (F, 3, 3)
     cross = np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0])
     area = np.linalg.norm(cross, axis=1) / 2.0

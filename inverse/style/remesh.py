@@ -93,8 +93,11 @@ def _outline(segments: np.ndarray) -> shapely.Polygon | None:
     that enclose nothing; those are closed by a thin buffer that is taken off again."""
     if len(segments) == 0:
         return None
-    lines = shapely.set_precision(shapely.linestrings(segments), WELD)
-    merged = shapely.unary_union(lines)  # nodes T-junctions between separately meshed walls
+    snapped = np.round(segments / WELD) * WELD  # near-equal ends (T-junctions) made equal
+    snapped = snapped[np.any(snapped[:, 0] != snapped[:, 1], axis=1)]
+    if len(snapped) == 0:
+        return None
+    merged = shapely.unary_union(shapely.linestrings(snapped))  # nodes the T-junctions
     polygons = [p for p in shapely.get_parts(shapely.polygonize([merged])) if p.area > 0]
     if not polygons:
         grown = shapely.get_parts(merged.buffer(NEIGHBOURHOOD, join_style="mitre"))
@@ -107,7 +110,7 @@ def _outline(segments: np.ndarray) -> shapely.Polygon | None:
         ]
         if not polygons:
             return None
-    union = shapely.unary_union(polygons)
+    union = shapely.unary_union(polygons) if len(polygons) > 1 else polygons[0]
     largest = max(shapely.get_parts(union), key=lambda p: p.area)
     return shapely.Polygon(largest.exterior)
 
