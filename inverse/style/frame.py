@@ -119,7 +119,7 @@ def standard_frame(mesh: TexturedMesh, faces: np.ndarray) -> Frame:
                 0,
                 0,
                 "the building has coordinates that are not finite metres"
-                + (f" once projected from {source[:200]} to {utm}" if utm else ""),
+                + (f" once projected from {(source or '')[:200]} to {utm}" if utm else ""),
                 "check the model's CRS and coordinates",
             )
         )
