@@ -49,10 +49,10 @@ def _box(extents, centre, transform=None) -> tuple[np.ndarray, np.ndarray]:
 # -- 1. a two-block stepped box, rotated and moved -------------------------------------------
 
 
-def _stepped():
+def _stepped(degrees: float = 30.0):
     """z up: a 10 x 6 x 8 base (x along 10) and a 6 x 4 x 12 tower on it centred at (1, 0.5),
-    turned 30 degrees about up and moved to (100, 200, 5)."""
-    turn = trimesh.transformations.rotation_matrix(np.radians(30.0), [0, 0, 1])
+    turned ``degrees`` about up and moved to (100, 200, 5)."""
+    turn = trimesh.transformations.rotation_matrix(np.radians(degrees), [0, 0, 1])
     turn[:3, 3] = [100.0, 200.0, 5.0]
     parts = [_box((10, 6, 8), (0, 0, 4), turn), _box((6, 4, 12), (1, 0.5, 14), turn)]
     return _mesh(parts), turn
@@ -69,6 +69,18 @@ def test_stepped_box_standard_frame_undoes_the_rotation():
     np.testing.assert_allclose(std, [[0, 0, 0], [0.25, 0, 0], [0, 0, -0.15], [0, 1, 0]], atol=1e-12)
     points = np.random.default_rng(1).normal(size=(20, 3)) * 50
     np.testing.assert_allclose(frame.unapply(frame.apply(points)), points, atol=1e-9)
+
+
+def test_the_axis_sign_points_within_90_degrees_of_the_input_x():
+    """Turned 240 degrees, the base's own +x points away from the input's +x: standard +x is
+    then the base's -x, and the tower (centred at +1 m, +0.5 m north of the base's centre)
+    lands at -0.05, +0.025: the stepped box seen from the other side."""
+    mesh, turn = _stepped(240.0)
+    capture, frame = capture_geometry(mesh, None)
+    assert np.linalg.det(frame.rotation) == pytest.approx(1.0)
+    end = frame.apply(turn[:3, :3] @ [5.0, 0.0, 0.0] + turn[:3, 3])
+    np.testing.assert_allclose(end, [[-0.25, 0.0, 0.0]], atol=1e-12)
+    np.testing.assert_allclose(capture.blocks[1].box, (-0.2, 0.1, -0.075, 0.125), atol=1e-9)
 
 
 def test_stepped_box_floors_blocks_and_walls():
