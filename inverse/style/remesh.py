@@ -93,12 +93,21 @@ def _outline(segments: np.ndarray) -> shapely.Polygon | None:
     that enclose nothing; those are closed by a thin buffer that is taken off again."""
     if len(segments) == 0:
         return None
-    snapped = np.round(segments / WELD) * WELD  # near-equal ends (T-junctions) made equal
+    snapped = np.round(segments / WELD) * WELD  # near-equal ends made equal
     snapped = snapped[np.any(snapped[:, 0] != snapped[:, 1], axis=1)]
     if len(snapped) == 0:
         return None
-    merged = shapely.unary_union(shapely.linestrings(snapped))  # nodes the T-junctions
-    polygons = [p for p in shapely.get_parts(shapely.polygonize([merged])) if p.area > 0]
+    lines = shapely.linestrings(snapped)
+    _, degree = np.unique(np.round(snapped / WELD).reshape(-1, 2), axis=0, return_counts=True)
+    polygons: list = []
+    if np.all(degree == 2):  # closed chains meeting end to end: polygonize as they are
+        merged = shapely.multilinestrings(lines)
+        polygons = [p for p in shapely.get_parts(shapely.polygonize([merged])) if p.area > 0]
+    # linework that polygonize left out (a crossing, a dangle) or used twice (a courtyard) means
+    # the chains were not simple: the slower path nodes them first
+    if not polygons or not np.isclose(sum(p.length for p in polygons), merged.length):
+        merged = shapely.union_all(lines)  # node crossings, T-junctions and shared walls first
+        polygons = [p for p in shapely.get_parts(shapely.polygonize([merged])) if p.area > 0]
     if not polygons:
         grown = shapely.get_parts(merged.buffer(NEIGHBOURHOOD, join_style="mitre"))
         grown = [shapely.Polygon(g.exterior) for g in grown if isinstance(g, shapely.Polygon)]
