@@ -294,3 +294,22 @@ def test_a_geographic_building_is_measured_in_metres():
     assert depth * 10 == pytest.approx(9.073 * 0.99974, rel=3e-4)
     assert height == pytest.approx(1.0)
     np.testing.assert_allclose(frame.unapply(frame.apply(v)), v, rtol=0, atol=1e-9)
+
+
+def test_a_courtyard_is_filled_and_the_largest_part_is_kept():
+    import shapely
+
+    ring = shapely.Polygon(
+        [(0, 0), (10, 0), (10, 10), (0, 10)], [[(3, 3), (7, 3), (7, 7), (3, 7)]]
+    )
+    court = trimesh.creation.extrude_polygon(ring, 5.0)  # z up, 0 to 5
+    capture, _ = capture_geometry(_mesh([(court.vertices, court.faces)]), None)
+    (outline,) = capture.contours  # the outer ring only: 10 m / 5 m = 2 units a side
+    assert sorted(map(tuple, outline.round(9))) == [(-1, -1), (-1, 1), (1, -1), (1, 1)]
+    assert [len(w) for w in capture.blocks[0].walls] == [1, 1, 1, 1]
+    # two towers 10 high, 6 x 4 at x = 0 and 2 x 2 at x = 10 (their box: x -3..11, centre 4)
+    parts = [_box((6, 4, 10), (0, 0, 5)), _box((2, 2, 10), (10, 0, 5))]
+    capture, _ = capture_geometry(_mesh(parts), None)
+    (outline,) = capture.contours
+    lo, hi = outline.min(axis=0), outline.max(axis=0)
+    np.testing.assert_allclose([lo[0], hi[0], lo[1], hi[1]], [-0.7, -0.1, -0.2, 0.2], atol=1e-12)
