@@ -76,6 +76,10 @@ class WallFace:
         return float(np.hypot(self.end[0] - self.start[0], self.end[1] - self.start[1]))
 
     @property
+    def height(self) -> float:
+        return self.top - self.bottom
+
+    @property
     def window_count(self) -> int:
         return sum(band.windows for band in self.bands)
 
