@@ -262,6 +262,18 @@ def test_window_size_merges_a_window_cut_by_its_muntin() -> None:
         detect_rule(img, "x", 6.0, window=math.nan)
 
 
+@pytest.mark.parametrize("axis", ["x", "y"])
+def test_variance_signal_is_the_summed_channel_variance(axis: str) -> None:
+    img = np.random.default_rng(3).integers(0, 256, (37, 53, 3), dtype=np.uint8)
+    img[:, 5] = (10, 200, 30)  # one column of one colour
+    img[7] = (90, 90, 90)  # one row of one colour
+    down = 0 if axis == "x" else 1
+    var = (img / 255.0).var(axis=down).sum(axis=-1)  # numpy's variance, 0..1 units
+    expected = (var - var.min()) / (var.max() - var.min())
+    assert variance_signal(img, axis) == pytest.approx(expected, abs=1e-9)
+    assert variance_signal(img, axis).argmin() == (5 if axis == "x" else 7)
+
+
 def test_signals_refuse_bad_images() -> None:
     with pytest.raises(ValueError):
         variance_signal(np.zeros((4, 4, 3), np.uint8), "z")

@@ -216,7 +216,7 @@ def merge_fragments(labels: np.ndarray, window: float | None = None) -> np.ndarr
 # --- rules --------------------------------------------------------------------------------
 
 
-@dataclass(frozen=True)
+@dataclass
 class Rule:
     """A splitting rule: m insertable sections between m + 1 scalable ones.
 

@@ -28,24 +28,22 @@ def _image(image: np.ndarray, axis: str) -> np.ndarray:
 
 def _channel_sums(img: np.ndarray, axis: str) -> tuple[np.ndarray, np.ndarray, int]:
     """Per position along ``axis`` and per channel: the sum of the values and of their squares
-    over the other axis, as (n, 3) float64, and how many values each sums.  Both are
-    reductions of a contiguous axis (integers down the columns, a float32 product with a
-    channel selector along the rows), so a 2000 x 256 texture takes a few milliseconds."""
+    over the other axis, as (n, 3) float64, and how many values each sums.  Exact integer
+    sums (uint32 while 255^2 times the count fits, uint64 beyond), each over a contiguous or
+    evenly strided last axis, so a 2000 x 256 texture takes a few milliseconds."""
     h, w, _ = img.shape
+    count = h if axis == "x" else w
+    total = np.uint32 if count * 255**2 < 2**32 else np.uint64
     if axis == "x":
-        wide = img.astype(np.uint16)  # 255^2 fits; the sums are taken in uint32
-        return (
-            wide.sum(axis=0, dtype=np.uint32).astype(np.float64),
-            (wide * wide).sum(axis=0, dtype=np.uint32).astype(np.float64),
-            h,
-        )
-    flat = img.reshape(h, w * 3).astype(np.float32)
-    selector = np.tile(np.eye(3, dtype=np.float32), (w, 1))  # (w * 3, 3): sums each channel
-    return (
-        (flat @ selector).astype(np.float64),
-        ((flat * flat) @ selector).astype(np.float64),
-        w,
-    )
+        wide = img.astype(np.uint16)  # 255^2 fits
+        first = wide.sum(axis=0, dtype=total)
+        second = (wide * wide).sum(axis=0, dtype=total)
+    else:
+        flat = img.reshape(h, w * 3).astype(np.uint16)  # a row's values, channel by channel
+        squares = flat * flat
+        first = np.stack([flat[:, c::3].sum(axis=1, dtype=total) for c in range(3)], axis=1)
+        second = np.stack([squares[:, c::3].sum(axis=1, dtype=total) for c in range(3)], axis=1)
+    return first.astype(np.float64), second.astype(np.float64), count
 
 
 def _unit_range(values: np.ndarray) -> np.ndarray:
