@@ -224,7 +224,8 @@ def build_parser() -> argparse.ArgumentParser:
 
     infer = commands.add_parser(
         "infer",
-        help="write a grammar from data: face schemas, a box hierarchy, or a whole city",
+        help="write a grammar from data: face schemas, a box hierarchy, a whole city, or a "
+        "textured building's style sheet",
         description="Infer a .bgr grammar from data. --kind city (the default for .obj, .ply, "
         ".glb, .gltf and CityJSON inputs): city-scale proceduralization of a 3D city, a "
         "grammar of component types whose meshes go in an assets folder beside it "
@@ -234,21 +235,25 @@ def build_parser() -> argparse.ArgumentParser:
         "(docs/inverse-schema.md) or a .bgr (derived first); the grammar, derived "
         'with --lot, styles a new mass. --kind boxes (the default for a .json with a "root" '
         "box): a box hierarchy as nested splits whose derivation at other sizes (--set width, "
-        "height, length) follows bgr retarget (docs/inverse-boxes.md).",
+        "height, length) follows bgr retarget (docs/inverse-boxes.md). --kind style (the "
+        "default for CityGML .gml and .xml): the style sheet of a textured Manhattan-world "
+        "building (CityGML with appearances, OBJ + MTL, glTF), its blocks, walls and per-face "
+        "window rules with texture crops in an assets folder, to derive on a lot or put on a "
+        "mass with bgr restyle (docs/inverse-style.md).",
     )
     infer.add_argument(
         "input",
         metavar="INPUT",
         help="a city (.obj, .ply, .glb, .gltf, .city.json, .city.jsonl), a box hierarchy "
-        ".json for --kind boxes, or a terminal list .json, captured-model .json or .bgr for "
-        "--kind schema",
+        ".json for --kind boxes, a terminal list .json, captured-model .json or .bgr for "
+        "--kind schema, or a textured model (.gml, .xml, .obj, .glb, .gltf) for --kind style",
     )
     infer.add_argument(
         "--kind",
         choices=["schema", "city", "boxes", "style", "image"],
         default=None,
         help="what to infer (default: city for 3D models and CityJSON, boxes for a box "
-        "hierarchy .json, schema otherwise; style and image are not written yet)",
+        "hierarchy .json, style for CityGML, schema otherwise; image is not written yet)",
     )
     infer.add_argument(
         "-o", "--output", metavar="OUT.bgr", help="write here (default: standard output)"
@@ -278,12 +283,16 @@ def build_parser() -> argparse.ArgumentParser:
     )
     add_memory_option(infer)
 
+    from .inverse.style.command import add_infer_options, add_restyle_parser
+
+    add_infer_options(infer)
     city = infer.add_argument_group("--kind city")
     city.add_argument(
         "--assets",
         metavar="DIR",
-        help="folder for the component meshes (default: OUT.assets beside -o OUT.bgr, or "
-        "./city.assets when the grammar goes to standard output); it must be new, empty or one "
+        help="folder for the component meshes (--kind style: the texture crops; default: "
+        "OUT.assets beside -o OUT.bgr, or ./city.assets (./style.assets) when the grammar goes "
+        "to standard output); it must be new, empty or one "
         "bgr wrote (with its .bgr-assets.json), as bgr replaces it whole",
     )
     city.add_argument(
@@ -342,6 +351,7 @@ def build_parser() -> argparse.ArgumentParser:
         "--no-progress", action="store_true", help="no progress bars on standard error"
     )
 
+    add_restyle_parser(commands, ALLOW_PATH_HELP, add_memory_option)
     retarget = commands.add_parser(
         "retarget",
         help="resize a box hierarchy, replicating, scaling and fixing its boxes",
@@ -796,9 +806,14 @@ def _infer(args) -> int:
         from .inverse.boxes.command import run_infer
 
         return run_infer(args)
+    if kind == "style":
+        from .inverse.style.command import run_infer as run_style
+
+        return run_style(args)
     if kind != "schema":
         print(
-            f"bgr infer: --kind {kind} is not written yet; --kind schema, city and boxes are",
+            f"bgr infer: --kind {kind} is not written yet; --kind schema, city, boxes and "
+            "style are",
             file=sys.stderr,
         )
         return EXIT_INPUT
@@ -827,8 +842,11 @@ def _infer(args) -> int:
 
 
 def _infer_kind(path: str) -> str:
-    """city for 3D models and CityJSON, schema for everything else (.bgr, other .json)."""
+    """city for 3D models and CityJSON, style for CityGML, schema for everything else (.bgr,
+    other .json)."""
     lower = path.lower()
+    if lower.endswith((".gml", ".xml")):
+        return "style"
     if lower.endswith((".obj", ".ply", ".glb", ".gltf", ".city.json", ".city.jsonl", ".jsonl")):
         return "city"
     if lower.endswith(".json"):
@@ -950,6 +968,12 @@ def cmd_render(args) -> int:
     return EXIT_OK
 
 
+def cmd_restyle(args) -> int:
+    from .inverse.style.command import run_restyle
+
+    return _under_ceiling(args, "restyle", "give a smaller mass", run_restyle)
+
+
 def cmd_retarget(args) -> int:
     from .inverse.boxes.command import run_retarget
 
@@ -963,6 +987,7 @@ COMMANDS = {
     "derive": cmd_derive,
     "render": cmd_render,
     "infer": cmd_infer,
+    "restyle": cmd_restyle,
 }
 
 
@@ -972,6 +997,7 @@ OUT_OF_MEMORY = {
     "render": "derive fewer or smaller shapes",
     "infer": "infer from a smaller input",
     "retarget": "ask a smaller size, or give fewer boxes",
+    "restyle": "give a smaller mass",
 }
 
 

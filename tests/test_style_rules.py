@@ -58,8 +58,12 @@ def test_split_h_face_narrower_than_one_pattern() -> None:
 
 def test_split_h_exact_repeats() -> None:
     # W = 30 = 3 patterns: x = 3 (not 2 by rounding); rest 0: y = 0; Sn = 6;
-    # Sr = (30 - 18) / (12 + a1) = 12 / 13: the tail's a1 takes its share
-    assert split_h([1, 2, 1], [3, 3], 30) == (6, pytest.approx(12 / 13))
+    # Sr = (30 - 18) / (12 + a1) = 12 / 13: the tail's a1 takes its share.  The tie-break
+    # (split_h's docstring): x = 2 repeats and the full tail y = m = 2 hold the same Sn = 6
+    # windows with Sr = (30 - 3 * 6) / (3 * 4) = 1, nearer 1 than 12 / 13: that is taken
+    assert split_h([1, 2, 1], [3, 3], 30) == (6, pytest.approx(1.0))
+    sizes = [size for _, _, size in layout([1, 2, 1], [3, 3], 30)]
+    assert sizes == pytest.approx([1, 3, 2, 3, 1] * 3)  # the texture three times, unstretched
     assert split_h([0.1, 0.1], [0.1], 0.3)[0] == 1  # 0.3 / 0.2 = 1.4999.. in floats: x = 1
 
 

@@ -333,7 +333,12 @@ def _split(A: Sequence[float], B: Sequence[float], W: float) -> tuple[int, int, 
             f"a face of size {W} cannot be filled: the scalables it would hold all have width 0 "
             "(an insertable touches the rule's edge and the face is narrower than it)"
         )
-    return x, y, max(fill, 0.0) / scalables
+    sr = max(fill, 0.0) / scalables
+    if y == 0 and x > 0 and sum_a > 0:  # a tie in Sn: x - 1 repeats and the full tail
+        alt = max(W - x * sum_b, 0.0) / (x * sum_a)
+        if abs(alt - 1.0) < abs(sr - 1.0):
+            return x - 1, m, alt
+    return x, y, sr
 
 
 def split_h(A: Sequence[float], B: Sequence[float], W: float) -> tuple[int, float]:
@@ -350,9 +355,15 @@ def split_h(A: Sequence[float], B: Sequence[float], W: float) -> tuple[int, floa
     size, then scales them again).  The factor that makes the pieces sum to W, as section
     5.2.3's text asks ("the remaining space ... is to be filled by the scalable elements"), is
     Sr = (W - x sum B - sum_(j<=y) b_j) / (x sum A + sum_(j<=y+1) a_j): the two agree when
-    x = 0.  With no insertable (m = 0) the face is one scalable a1 stretched: Sn = 0,
-    Sr = W / a1.  Raises ValueError on non-finite or negative input, on a rule of zero width,
-    and when the scalables a face would hold all have width 0 but space is left."""
+    x = 0.  Second deviation, a tie-break: equation 8 makes W = x patterns exactly into x
+    repeats and a tail of a1 alone (y = 0), whose scalables, one more than the texture had,
+    all shrink; x - 1 repeats and the full tail b1 .. bm (y = m) hold the same Sn = x m
+    windows, and there every piece keeps the size it was measured at.  Of the two, the layout
+    whose Sr is nearer 1 (whose walls stretch least) is taken, so a style sheet derived back
+    on its source's own faces reproduces them.  With no insertable (m = 0) the face is one
+    scalable a1 stretched: Sn = 0, Sr = W / a1.  Raises ValueError on non-finite or negative
+    input, on a rule of zero width, and when the scalables a face would hold all have width 0
+    but space is left."""
     x, y, sr = _split(A, B, W)
     return x * len(B) + y, sr
 

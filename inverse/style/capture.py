@@ -1,0 +1,148 @@
+"""Capture (section 4): a textured model in, one style sheet section per building out.
+
+The stages, each in its own module: the standard view and the remeshed floors, blocks and
+walls (frame.py, remesh.py), the faces' textures (project.py), the consistent face groups and
+their splitting rules (groups.py, rules.py), and the grammar (emit.py).
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from bgr.formats.textured_model import TexturedMesh
+from bgr.grammar.errors import BgrError, Diagnostic
+
+from .emit import Crops, style_text
+from .groups import Groups, face_groups
+from .model import Capture
+from .project import face_textures
+from .remesh import capture_geometry
+
+READERS = {
+    ".gml": "citygml",
+    ".xml": "citygml",
+    ".obj": "obj",
+    ".glb": "gltf",
+    ".gltf": "gltf",
+}
+
+
+def read_model(path: str) -> TexturedMesh:
+    """The textured model in ``path``, by its extension (CityGML, OBJ + MTL, glTF / GLB)."""
+    kind = READERS.get(Path(path).suffix.lower())
+    if kind == "citygml":
+        from bgr.formats.citygml_read import read_citygml
+
+        return read_citygml(path)
+    if kind == "obj":
+        from bgr.formats.obj_textured import read_obj_textured
+
+        return read_obj_textured(path)
+    if kind == "gltf":
+        from bgr.formats.gltf_textured import read_gltf_textured
+
+        return read_gltf_textured(path)
+    raise BgrError(
+        Diagnostic(
+            path,
+            0,
+            0,
+            "bgr infer --kind style reads a textured model: CityGML (.gml, .xml), OBJ with its "
+            "MTL (.obj) or glTF (.glb, .gltf)",
+            "export the building as one of these with its textures",
+        )
+    )
+
+
+def building_ids(mesh: TexturedMesh, building: str | None) -> list[str | None]:
+    """The buildings to capture: ``building`` alone; else, in a CityGML file, every building
+    (object) with a textured face, in the file's order; else the whole model as one building
+    (an OBJ's groups and a glTF's nodes are parts, not buildings).  A located error when no
+    face is textured."""
+    textured = mesh.textured()
+    if not textured.any():
+        raise BgrError(
+            Diagnostic(
+                mesh.source,
+                0,
+                0,
+                "the model has no textured face: a style sheet is captured from a building's "
+                "photographic textures",
+                "give a model whose walls carry texture images (CityGML appearances, OBJ "
+                "map_Kd, glTF baseColorTexture), with the images beside it",
+            )
+        )
+    if building is not None:
+        if building not in mesh.object_ids:
+            shown = ", ".join(mesh.object_ids[:5]) + (" ..." if len(mesh.object_ids) > 5 else "")
+            raise BgrError(
+                Diagnostic(
+                    mesh.source,
+                    0,
+                    0,
+                    f"--building {building}: the model has no object of that id",
+                    f"its objects are {shown}",
+                )
+            )
+        if not textured[mesh.mask(object_id=building)].any():
+            raise BgrError(
+                Diagnostic(
+                    mesh.source,
+                    0,
+                    0,
+                    f"--building {building}: no face of that building is textured",
+                    "pick a building whose walls carry texture images",
+                )
+            )
+        return [building]
+    if Path(mesh.source).suffix.lower() not in (".gml", ".xml"):
+        return [None]
+    used = np.unique(mesh.object[textured])
+    return [mesh.object_ids[i] for i in used]
+
+
+@dataclass
+class Captured:
+    """One building's capture: its remeshed structure, groups and rules, and the frame that
+    maps the input into the standard view."""
+
+    capture: Capture
+    groups: Groups
+    frame: object  # remesh.Frame
+    seconds: float = 0.0
+    notes: list[str] = field(default_factory=list)
+
+
+def capture_building(
+    mesh: TexturedMesh, building: str | None, texels_per_unit: float | None = None
+) -> Captured:
+    """Sections 4.1-4.3 for one building of ``mesh`` (None: the whole mesh as one)."""
+    start = time.perf_counter()
+    capture, frame = capture_geometry(mesh, building)
+    select = (
+        mesh.mask(object_id=building) if building is not None else np.ones(len(mesh.faces), bool)
+    )
+    vertices = frame.apply(mesh.vertices)
+    face_textures(mesh, vertices, select, capture.faces, texels_per_unit)
+    groups = face_groups(capture)
+    return Captured(capture, groups, frame, time.perf_counter() - start)
+
+
+def infer_style(
+    path: str,
+    building: str | None = None,
+    assets: str = "style.assets",
+    max_texture_size: int = 512,
+    mesh: TexturedMesh | None = None,
+) -> tuple[str, dict[str, bytes], list[Captured]]:
+    """The style sheet of the model in ``path``: its ``.bgr`` text, its crops (file name ->
+    PNG bytes, for the folder the grammar names ``assets``) and each building's capture."""
+    mesh = mesh if mesh is not None else read_model(path)
+    captured = [capture_building(mesh, b) for b in building_ids(mesh, building)]
+    crops = Crops(assets, max_texture_size)
+    text = style_text([(c.capture, c.groups) for c in captured], crops)
+    return text, crops.files, captured

@@ -1,0 +1,178 @@
+"""Consistent face groups (section 4.3.3) and the splitting rules detected on their averaged
+textures (section 4.3.4).
+
+A rule detected on one face alone generalises badly (the paper's figure 7a): windows of faces
+stacked one above the other drift apart, faces with a poor photograph get no rule.  So faces
+are grouped, and each group's members are averaged into one texture before detection:
+
+* a **horizontally consistent group** is every face between the same two floors (one level):
+  its windows share storey rows, so the level gets one **vertical** rule (C, D: rows);
+* a **vertically consistent group** links each face to the face of the floor above that it
+  overlaps most, when their widths agree (equation 1, phi_shape > 0.9) and so do their column
+  signals (equation 2, phi_texture > 0.5): a stack of faces sharing window columns, which gets
+  one **horizontal** rule (A, B: columns).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from .model import Capture, Face
+from .rules import Rule, detect_rule
+
+SHAPE_LINK = 0.9  # phi_shape above which two stacked faces can share columns (section 4.3.3)
+TEXTURE_LINK = 0.5  # phi_texture above which they do
+SIGNAL_SAMPLES = 64  # points at which two column signals are compared over their overlap
+
+
+@dataclass
+class Groups:
+    """Which group each face of ``Capture.faces`` belongs to, and each group's rule.
+
+    Rule lengths are in metres (the capture's unit height times ``Capture.scale``), so that a
+    window keeps its size on a target of any size; ``Rule.sections`` are fractions of the
+    averaged texture, top to bottom and left to right as the textures are stored."""
+
+    faces: list[Face]
+    horizontal: list[int]  # per face: its level's group (index into rows)
+    vertical: list[int]  # per face: its stack's group (index into columns)
+    rows: list[Rule]  # per horizontal group: the vertical rule C, D (storey rows)
+    columns: list[Rule]  # per vertical group: the horizontal rule A, B (window columns)
+    row_cuts: list[list[tuple[str, float, float]]]  # per rows[g]: its sections as fractions
+    # of the texture's height, top to bottom ("scalable" or "insertable", first, end)
+    column_cuts: list[list[tuple[str, float, float]]]  # per columns[g]: fractions of the
+    # width, left to right
+
+
+RIGHTWARD = np.array([(-1.0, 0.0), (0.0, -1.0), (1.0, 0.0), (0.0, 1.0)])
+"""(x, z) direction of each wall's left to right seen from outside (a comp(f) face's x axis:
+y up crossed with the outward normal)."""
+
+
+def along(face: Face) -> tuple[float, float]:
+    """The interval a face covers along its wall's left-to-right axis: a jog square to the wall
+    covers none."""
+    axis = RIGHTWARD[face.wall]
+    a, b = float(face.start @ axis), float(face.end @ axis)
+    return (min(a, b), max(a, b))
+
+
+def shape_similarity(lower: Face, upper: Face) -> float:
+    """Equation 1: the width of the two faces' overlap over the narrower face's width."""
+    (a0, a1), (b0, b1) = along(lower), along(upper)
+    overlap = max(0.0, min(a1, b1) - max(a0, b0))
+    narrower = min(a1 - a0, b1 - b0)
+    return overlap / narrower if narrower > 0 else 0.0
+
+
+def column_signal(face: Face, lo: float, hi: float) -> np.ndarray | None:
+    """omega of equation 2: the face's pixel columns averaged (grey, 0..1), sampled at
+    SIGNAL_SAMPLES points of the stretch lo..hi of its wall; None when untextured."""
+    if face.texture is None:
+        return None
+    grey = face.texture.astype(np.float64).mean(axis=2).mean(axis=0) / 255.0
+    a0, a1 = along(face)
+    at = (np.linspace(lo, hi, SIGNAL_SAMPLES) - a0) / max(a1 - a0, 1e-12)
+    cols = np.clip((at * len(grey)).astype(np.int64), 0, len(grey) - 1)
+    return grey[cols]
+
+
+def texture_similarity(lower: Face, upper: Face) -> float:
+    """Equation 2: the correlation of the two faces' column signals over their overlap.  Two
+    untextured faces are alike (1); a textured and an untextured face are not (0); a flat
+    signal correlates with another flat one only."""
+    (a0, a1), (b0, b1) = along(lower), along(upper)
+    lo, hi = max(a0, b0), min(a1, b1)
+    s, t = column_signal(lower, lo, hi), column_signal(upper, lo, hi)
+    if s is None or t is None:
+        return 1.0 if s is None and t is None else 0.0
+    ds, dt = s - s.mean(), t - t.mean()
+    ns, nt = float(np.sqrt(ds @ ds)), float(np.sqrt(dt @ dt))
+    if ns < 1e-9 or nt < 1e-9:
+        return 1.0 if ns < 1e-9 and nt < 1e-9 else 0.0
+    return float(ds @ dt) / (ns * nt)
+
+
+def vertical_links(faces: list[Face]) -> list[int]:
+    """Union-find of the bottom-to-top traversal: each face is linked to the face of the next
+    level on the same wall side that overlaps it most, when equations 1 and 2 agree."""
+    parent = list(range(len(faces)))
+
+    def root(i: int) -> int:
+        while parent[i] != i:
+            parent[i] = parent[parent[i]]
+            i = parent[i]
+        return i
+
+    by_level: dict[tuple[int, int], list[int]] = {}
+    for i, f in enumerate(faces):
+        by_level.setdefault((f.wall, f.level), []).append(i)
+    for i, f in enumerate(faces):
+        above = by_level.get((f.wall, f.level + 1), [])
+        if not above:
+            continue
+        best = max(above, key=lambda j: (shape_similarity(f, faces[j]), -j))
+        if (
+            shape_similarity(f, faces[best]) > SHAPE_LINK
+            and texture_similarity(f, faces[best]) > TEXTURE_LINK
+        ):
+            parent[root(best)] = root(i)
+    roots = [root(i) for i in range(len(faces))]
+    order = {r: k for k, r in enumerate(dict.fromkeys(roots))}
+    return [order[r] for r in roots]
+
+
+def averaged(faces: list[Face]) -> np.ndarray | None:
+    """The members' textures resampled to the median size and averaged (section 4.3.4: "we
+    average texture maps of all group members for the detection of the rules")."""
+    textures = [f.texture for f in faces if f.texture is not None]
+    if not textures:
+        return None
+    h = int(np.median([t.shape[0] for t in textures]))
+    w = int(np.median([t.shape[1] for t in textures]))
+    total = np.zeros((h, w, 3))
+    for t in textures:
+        rows = np.minimum((np.arange(h) + 0.5) * t.shape[0] // h, t.shape[0] - 1).astype(int)
+        cols = np.minimum((np.arange(w) + 0.5) * t.shape[1] // w, t.shape[1] - 1).astype(int)
+        total += t[rows][:, cols]
+    return (total / len(textures)).astype(np.uint8)
+
+
+def _rule(
+    members: list[Face], axis: str, length: float
+) -> tuple[Rule, list[tuple[str, float, float]]]:
+    image = averaged(members)
+    if image is None:  # untextured: one scalable piece, no window
+        return Rule(axis, (length,), ()), [("scalable", 0.0, 1.0)]
+    rule = detect_rule(image, axis, length)
+    n = image.shape[0 if axis == "y" else 1]
+    return rule, [(kind, first / n, end / n) for kind, first, end in rule.sections]
+
+
+def face_groups(capture: Capture) -> Groups:
+    """Both kinds of group of every face, and their rules in metres."""
+    faces = capture.faces
+    levels = sorted({f.level for f in faces})
+    horizontal = [levels.index(f.level) for f in faces]
+    vertical = vertical_links(faces)
+    rows = []
+    for g, level in enumerate(levels):
+        members = [f for f, h in zip(faces, horizontal, strict=True) if h == g]
+        height = (capture.floors[level + 1] - capture.floors[level]) * capture.scale
+        rows.append(_rule(members, "y", float(height)))
+    columns = []
+    for g in range(max(vertical, default=-1) + 1):
+        members = [f for f, v in zip(faces, vertical, strict=True) if v == g]
+        width = float(np.mean([f.width for f in members])) * capture.scale
+        columns.append(_rule(members, "x", width))
+    return Groups(
+        faces,
+        horizontal,
+        vertical,
+        [r for r, _ in rows],
+        [r for r, _ in columns],
+        [c for _, c in rows],
+        [c for _, c in columns],
+    )

@@ -1,0 +1,148 @@
+"""Style retargeting onto a given mass (section 5): ``bgr restyle MASS --style STYLE.bgr``.
+
+The mass's structure is found as the source's was (section 4.2: floors, cuts at local maxima of
+the floor-area ratio, blocks).  Each of its blocks takes one of the style sheet's source blocks
+by the transformation cost of equations 6 and 7 (greedy, bottom to top; the bottom block takes
+the source's bottom and the top block its top, the paper's forced matches), and becomes a lot:
+the outline of its first floor, at its base height, extruded to its height by the sheet's
+``Lot`` rule with ``block`` naming the source block, so that the block's walls are split by that
+block's rules (equations 8 and 9) in the grammar itself.
+"""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Iterable
+
+import numpy as np
+
+from bgr.grammar import nodes as n
+from bgr.grammar.errors import BgrError, Diagnostic
+
+
+def shape_cost(source: tuple[float, float, float], target: tuple[float, float, float]) -> float:
+    """Equation 7: each block's (width, height, depth) normalised to sum 1, and the product
+    over the three dimensions of the larger-over-smaller ratio."""
+    s = np.asarray(source, float) / float(np.sum(source))
+    t = np.asarray(target, float) / float(np.sum(target))
+    return float(np.prod(np.maximum(s / t, t / s)))
+
+
+def relative_volumes(blocks: list[tuple[float, float, float]]) -> np.ndarray:
+    """vol-bar of section 5.1.1: each block's volume over its building's total."""
+    v = np.array([w * h * d for w, h, d in blocks], float)
+    return v / v.sum()
+
+
+def match_blocks(
+    source: list[tuple[float, float, float]], target: list[tuple[float, float, float]]
+) -> list[int]:
+    """For each target block (bottom to top), the source block of least Psi = Psi_shape x
+    Psi_volume (equation 6).  The bottom target block takes the source's bottom block and the
+    top target block its top one; a block between them chooses among the source's middle
+    blocks (the paper: its bottom and top have shapes and textures found nowhere else), or
+    among all of them when the source has none."""
+    if not source or not target:
+        return []
+    vs, vt = relative_volumes(source), relative_volumes(target)
+    middle = list(range(1, len(source) - 1)) or list(range(len(source)))
+    out = []
+    for j, t in enumerate(target):
+        if j == 0:
+            out.append(0)
+        elif j == len(target) - 1:
+            out.append(len(source) - 1)
+        else:
+            costs = [
+                shape_cost(source[i], t) * max(vs[i], vt[j]) / min(vs[i], vt[j]) for i in middle
+            ]
+            out.append(middle[int(np.argmin(costs))])
+    return out
+
+
+def source_blocks(grammar, prefix: str = "") -> list[tuple[float, float, float]]:
+    """The source blocks' sizes a style sheet records (``const block0_width`` ...)."""
+    out = []
+    k = 0
+    while f"{prefix}block{k}_width" in grammar.consts:
+        size = []
+        for what in ("width", "height", "depth"):
+            value = grammar.consts.get(f"{prefix}block{k}_{what}")
+            if value is None or not isinstance(value.value, n.Number):
+                break
+            size.append(float(value.value.value))
+        if len(size) != 3 or min(size) <= 0:
+            break
+        out.append((size[0], size[1], size[2]))
+        k += 1
+    if not out:
+        raise BgrError(
+            Diagnostic(
+                grammar.path,
+                0,
+                0,
+                "not a style sheet: it records no source blocks (const block0_width, ...)",
+                "give a grammar written by bgr infer --kind style",
+            )
+        )
+    return out
+
+
+def _front_first(ring: np.ndarray) -> np.ndarray:
+    """The ring turned to start at its front edge: the longest of the edges facing -z."""
+    ring = np.asarray(ring, float)
+    if len(ring) > 1 and np.allclose(ring[0], ring[-1]):
+        ring = ring[:-1]
+    edges = np.roll(ring, -1, axis=0) - ring
+    length = np.hypot(edges[:, 0], edges[:, 1])
+    centre = ring.mean(axis=0)
+    mid = ring + edges / 2
+    # an edge faces -z when its midpoint lies on the -z side of the centre and it runs along x
+    facing = (mid[:, 1] < centre[1]) & (np.abs(edges[:, 0]) >= np.abs(edges[:, 1]))
+    score = np.where(facing, length, -1.0)
+    k = int(np.argmax(score)) if facing.any() else int(np.argmin(mid[:, 1]))
+    return np.roll(ring, -k, axis=0)
+
+
+def restyle(
+    mass: str,
+    style: str,
+    seed: int = 0,
+    allow_paths: Iterable[str | os.PathLike] = (),
+):
+    """The styled mass (a bgr.interpreter.derive.Result) and a one-line report."""
+    from bgr.grammar.loader import load
+    from bgr.interpreter.derive import derive
+    from bgr.interpreter.lots import footprint
+
+    from .capture import read_model
+    from .remesh import capture_geometry
+
+    grammar = load(style, allow_paths=allow_paths)
+    prefix = "S0" if "S0block0_width" in grammar.consts else ""
+    sources = source_blocks(grammar, prefix)
+    mesh = read_model(mass)
+    capture, frame = capture_geometry(mesh, None)
+    scale = capture.scale
+    targets = [tuple(v * scale for v in b.size) for b in capture.blocks]
+    matched = match_blocks(sources, targets)  # type: ignore[arg-type]
+    lots = []
+    for j, block in enumerate(capture.blocks):
+        ring = _front_first(capture.contours[block.levels[0]])
+        points = np.column_stack([ring[:, 0], np.full(len(ring), block.bottom), ring[:, 1]])
+        world = frame.unapply(points)
+        base = float(world[:, 1].mean())
+        lots.append(
+            footprint(
+                [(float(x), float(z)) for x, _, z in world],
+                {
+                    "block": matched[j],
+                    "block_base": base,
+                    "block_height": (block.top - block.bottom) * scale,
+                },
+                name=f"block {j}",
+            )
+        )
+    result = derive(grammar, seed=seed, lot=lots)
+    pairs = ", ".join(f"{j}<-{i}" for j, i in enumerate(matched))
+    return result, f"{len(lots)} blocks styled by source blocks ({pairs})"
