@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import numpy as np
 import shapely
+from shapely.geometry.polygon import orient
 
 from bgr.formats.textured_model import TexturedMesh
 from bgr.grammar.errors import BgrError, Diagnostic
@@ -167,7 +168,7 @@ def _clean(polygon: shapely.Polygon) -> np.ndarray:
     simple = polygon.simplify(NEIGHBOURHOOD, preserve_topology=True)
     if simple.is_empty or simple.area <= 0:
         simple = polygon
-    ring = np.asarray(shapely.orient_polygons(simple, exterior_cw=False).exterior.coords)[:-1]
+    ring = np.asarray(orient(simple, sign=1.0).exterior.coords)[:-1]  # shapely 2.0 has orient
     keep = np.ones(len(ring), dtype=bool)
     for _ in range(len(ring)):  # short edges: drop the later end, until none is left (rare)
         pts = ring[keep]
@@ -195,15 +196,29 @@ def contours(
     there, whose outline belongs to the interval below or above, ambiguously), and for the
     vertical walls of a Manhattan-world building the section is the same at every height of the
     interval, so the middle is no loss.  Where a section gives several polygons (two towers on
-    one podium), the largest is kept: section 4.3.1 breaks one outline per floor into walls."""
-    v = np.asarray(mesh_std_vertices, dtype=np.float64)
+    one podium), the largest is kept: section 4.3.1 breaks one outline per floor into walls.
+    Heights within 0.0005 of a floor are moved onto it here (vertices need not be snapped)."""
+    v = np.array(mesh_std_vertices, dtype=np.float64)
     f = np.asarray(faces, dtype=np.int64)
     levels = np.asarray(floors, dtype=np.float64)
+    v[:, 1] = _snap(v[:, 1], levels)
     out = []
     for lo, hi in zip(levels[:-1], levels[1:], strict=True):
         polygon = _outline(_section(v, f, (lo + hi) / 2.0))
         out.append(np.zeros((0, 2)) if polygon is None else _clean(polygon))
     return out
+
+
+def _snap(heights: np.ndarray, levels: np.ndarray) -> np.ndarray:
+    """Each height moved onto the nearest floor when it is within FLOOR_GAP of the span (the
+    vertical alignment of section 4.1); others are kept."""
+    if len(levels) == 0:
+        return heights
+    at = np.clip(np.searchsorted(levels, heights), 1, max(len(levels) - 1, 1))
+    below, above = levels[at - 1], levels[np.minimum(at, len(levels) - 1)]
+    nearest = np.where(np.abs(heights - below) <= np.abs(above - heights), below, above)
+    span = float(levels[-1] - levels[0])
+    return np.where(np.abs(heights - nearest) < FLOOR_GAP * max(span, 1e-300), nearest, heights)
 
 
 def _area(ring: np.ndarray) -> float:
