@@ -330,3 +330,19 @@ def test_parts_sharing_a_wall_are_one_outline_among_many_small_ones():
     for ring in capture.contours:
         assert len(ring) == 4
         np.testing.assert_allclose(np.ptp(ring, axis=0), [1.0, 0.6], atol=1e-12)
+
+
+def test_an_l_with_equal_arms_is_aligned_with_its_walls():
+    """The principal axes of an L whose arms are equal lie on its diagonal; the standard view
+    still lines the walls up with x and z (frame.py, step 3): turned 20 degrees, every outline
+    edge comes out axis-parallel and the box is 10 x 10 m."""
+    import shapely
+
+    ell = shapely.Polygon([(0, 0), (10, 0), (10, 4), (4, 4), (4, 10), (0, 10)])
+    solid = trimesh.creation.extrude_polygon(ell, 5.0)
+    solid.apply_transform(trimesh.transformations.rotation_matrix(np.radians(20.0), [0, 0, 1]))
+    capture, frame = capture_geometry(_mesh([(solid.vertices, solid.faces)]), None)
+    (ring,) = capture.contours
+    edges = np.roll(ring, -1, axis=0) - ring
+    assert len(ring) == 6 and np.all(np.min(np.abs(edges), axis=1) < 1e-9)
+    np.testing.assert_allclose(capture.blocks[0].size, (2.0, 1.0, 2.0), atol=1e-9)
