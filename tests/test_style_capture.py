@@ -299,9 +299,7 @@ def test_a_geographic_building_is_measured_in_metres():
 def test_a_courtyard_is_filled_and_the_largest_part_is_kept():
     import shapely
 
-    ring = shapely.Polygon(
-        [(0, 0), (10, 0), (10, 10), (0, 10)], [[(3, 3), (7, 3), (7, 7), (3, 7)]]
-    )
+    ring = shapely.Polygon([(0, 0), (10, 0), (10, 10), (0, 10)], [[(3, 3), (7, 3), (7, 7), (3, 7)]])
     court = trimesh.creation.extrude_polygon(ring, 5.0)  # z up, 0 to 5
     capture, _ = capture_geometry(_mesh([(court.vertices, court.faces)]), None)
     (outline,) = capture.contours  # the outer ring only: 10 m / 5 m = 2 units a side
@@ -313,3 +311,38 @@ def test_a_courtyard_is_filled_and_the_largest_part_is_kept():
     (outline,) = capture.contours
     lo, hi = outline.min(axis=0), outline.max(axis=0)
     np.testing.assert_allclose([lo[0], hi[0], lo[1], hi[1]], [-0.7, -0.1, -0.2, 0.2], atol=1e-12)
+
+
+def test_area_noise_is_no_cut():
+    # r = 1.001, 1, 4, 1: the 0.1 % step is noise (RATIO_NOISE), not a local maximum
+    assert list(cut_floors(np.array([4.0, 4.004, 4.004, 1.0, 1.0]))) == [3]
+
+
+def test_parts_sharing_a_wall_are_one_outline_among_many_small_ones():
+    """A 6 x 6 and a 4 x 6 box side by side (one wall shared, meshed twice), 10 high, and a row
+    of 20 sheds 0.3 m wide and 1 m high: the section at 0.5 m has 21 parts; its outline is the
+    10 x 6 rectangle the two boxes make (4 corners: the shared wall is inside)."""
+    parts = [_box((6, 6, 10), (-2, 0, 5)), _box((4, 6, 10), (3, 0, 5))]
+    parts += [_box((0.3, 0.3, 1), (x, 8, 0.5)) for x in np.linspace(-4.5, 4.5, 20)]
+    capture, _ = capture_geometry(_mesh(parts), None)
+    np.testing.assert_allclose(capture.floors, [0.0, 0.1, 1.0])
+    assert len(capture.blocks) == 1
+    for ring in capture.contours:
+        assert len(ring) == 4
+        np.testing.assert_allclose(np.ptp(ring, axis=0), [1.0, 0.6], atol=1e-12)
+
+
+def test_an_l_with_equal_arms_is_aligned_with_its_walls():
+    """The principal axes of an L whose arms are equal lie on its diagonal; the standard view
+    still lines the walls up with x and z (frame.py, step 3): turned 20 degrees, every outline
+    edge comes out axis-parallel and the box is 10 x 10 m."""
+    import shapely
+
+    ell = shapely.Polygon([(0, 0), (10, 0), (10, 4), (4, 4), (4, 10), (0, 10)])
+    solid = trimesh.creation.extrude_polygon(ell, 5.0)
+    solid.apply_transform(trimesh.transformations.rotation_matrix(np.radians(20.0), [0, 0, 1]))
+    capture, frame = capture_geometry(_mesh([(solid.vertices, solid.faces)]), None)
+    (ring,) = capture.contours
+    edges = np.roll(ring, -1, axis=0) - ring
+    assert len(ring) == 6 and np.all(np.min(np.abs(edges), axis=1) < 1e-9)
+    np.testing.assert_allclose(capture.blocks[0].size, (2.0, 1.0, 2.0), atol=1e-9)

@@ -19,10 +19,11 @@ is that replacement.  How each step is made:
    wall directions is x: the one along which the wall area's second moment (its exact
    area-weighted covariance, triangle by triangle) is larger, i.e. the building's longer axis.
 4. **Sign.** Of the two opposite directions of that axis, x is the one within 90 degrees of the
-   input's own +x (east, for a geographic file); ties (exactly north-south) take the one whose
-   input z is positive.  The rotation is about y, so it is proper (det +1, no mirror), and
-   z follows: the *front* wall (outward -z) is the long side that faces the input's -z (north,
-   for a z-up geographic file).
+   input's own +x (east, for a geographic file); ties (exactly north-south) take the one along
+   the y-up frame's +z (the input's +z for a y-up file, its -y for a z-up one).  The rotation is
+   about y, so it is proper (det +1, no mirror), and z follows: the *front* wall (outward -z) is
+   the long side that faces the input's -z for a y-up file, its +y for a z-up one (north, for a
+   geographic file).
 5. **Scale.** The lowest point goes to y = 0, the bounding box is centred in x and z, and the
    model is divided by its height (``Frame.scale`` metres a unit).
 """

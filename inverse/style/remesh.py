@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import numpy as np
 import shapely
+from shapely.geometry.polygon import orient
 
 from bgr.formats.textured_model import TexturedMesh
 from bgr.grammar.errors import BgrError, Diagnostic
@@ -34,8 +35,15 @@ WELD = 1e-7
 triangulated one by one, so a corner shared by a wall and a roof appears once per polygon."""
 
 RATIO_EPS = 1e-6
-"""Two floor-area ratios closer than this (relative) are equal when local maxima are found:
-float noise in two equal areas must not make a cut (section 4.2)."""
+"""Two floor-area ratios closer than this (relative) are equal when local maxima are found
+(section 4.2)."""
+
+RATIO_NOISE = 0.01
+"""A floor-area ratio below 1 + this is 1: no change of shape.  Deviation from section 4.2,
+whose local maxima need no threshold on clean models: a real model's walls lean and its outlines
+are simplified (NEIGHBOURHOOD), so successive areas of one straight block differ by parts in
+10,000, and among such ratios every local maximum would be a cut.  1 % is above that noise
+(the simplification moves an outline's area by about 0.3 %) and far below a setback's change."""
 
 
 def floor_groups(heights: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -102,11 +110,13 @@ def _outline(segments: np.ndarray) -> shapely.Polygon | None:
     polygons: list = []
     if np.all(degree == 2):  # closed chains meeting end to end: polygonize as they are
         merged = shapely.multilinestrings(lines)
-        polygons = [p for p in shapely.get_parts(shapely.polygonize([merged])) if p.area > 0]
-    # linework that polygonize left out (a crossing, a dangle) or used twice (a courtyard) means
-    # the chains were not simple: the slower path nodes them first
-    if not polygons or not np.isclose(sum(p.length for p in polygons), merged.length):
-        merged = shapely.union_all(lines)  # node crossings, T-junctions and shared walls first
+        found, cuts, dangles, invalid = shapely.polygonize_full([merged])
+        if cuts.is_empty and dangles.is_empty and invalid.is_empty:
+            polygons = [p for p in shapely.get_parts(found) if p.area > 0]
+    # chains that touch or cross themselves (or ends that meet three ways: T-junctions, a wall
+    # two parts share) are noded first, the slower path
+    if not polygons:
+        merged = shapely.union_all(lines)
         polygons = [p for p in shapely.get_parts(shapely.polygonize([merged])) if p.area > 0]
     if not polygons:
         grown = shapely.get_parts(merged.buffer(NEIGHBOURHOOD, join_style="mitre"))
@@ -119,9 +129,37 @@ def _outline(segments: np.ndarray) -> shapely.Polygon | None:
         ]
         if not polygons:
             return None
-    union = shapely.unary_union(polygons) if len(polygons) > 1 else polygons[0]
-    largest = max(shapely.get_parts(union), key=lambda p: p.area)
-    return shapely.Polygon(largest.exterior)
+    return shapely.Polygon(_largest(np.array(polygons, dtype=object)).exterior)
+
+
+def _largest(polygons: np.ndarray) -> shapely.Polygon:
+    """The largest part of the union of ``polygons`` (an object array), unioning only the
+    polygons of that part: a model of many buildings has many far-apart polygons in one
+    section.  The parts are the connected components of "intersects" (an STRtree query); the sum
+    of a component's areas bounds its union's (polygons that overlap count twice), so components
+    are unioned largest bound first until no bound left can beat the best union."""
+    if len(polygons) <= 16:  # a few: one union costs less than finding the parts
+        union = shapely.union_all(polygons) if len(polygons) > 1 else polygons[0]
+        return max(shapely.get_parts(union), key=lambda p: p.area)
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import connected_components
+
+    pairs = shapely.STRtree(polygons).query(polygons, predicate="intersects")
+    n = len(polygons)
+    graph = coo_matrix((np.ones(pairs.shape[1]), (pairs[0], pairs[1])), shape=(n, n))
+    _, label = connected_components(graph, directed=False)
+    bound = np.bincount(label, weights=shapely.area(polygons))  # >= the part's area
+    best: shapely.Polygon | None = None
+    for component in np.argsort(-bound, kind="stable"):
+        if best is not None and bound[component] <= best.area:
+            break
+        members = polygons[label == component]
+        union = shapely.union_all(members) if len(members) > 1 else members[0]
+        part = max(shapely.get_parts(union), key=lambda p: p.area)
+        if best is None or part.area > best.area:
+            best = part
+    assert best is not None
+    return best
 
 
 def _clean(polygon: shapely.Polygon) -> np.ndarray:
@@ -130,7 +168,7 @@ def _clean(polygon: shapely.Polygon) -> np.ndarray:
     simple = polygon.simplify(NEIGHBOURHOOD, preserve_topology=True)
     if simple.is_empty or simple.area <= 0:
         simple = polygon
-    ring = np.asarray(shapely.orient_polygons(simple, exterior_cw=False).exterior.coords)[:-1]
+    ring = np.asarray(orient(simple, sign=1.0).exterior.coords)[:-1]  # shapely 2.0 has orient
     keep = np.ones(len(ring), dtype=bool)
     for _ in range(len(ring)):  # short edges: drop the later end, until none is left (rare)
         pts = ring[keep]
@@ -158,15 +196,29 @@ def contours(
     there, whose outline belongs to the interval below or above, ambiguously), and for the
     vertical walls of a Manhattan-world building the section is the same at every height of the
     interval, so the middle is no loss.  Where a section gives several polygons (two towers on
-    one podium), the largest is kept: section 4.3.1 breaks one outline per floor into walls."""
-    v = np.asarray(mesh_std_vertices, dtype=np.float64)
+    one podium), the largest is kept: section 4.3.1 breaks one outline per floor into walls.
+    Heights within 0.0005 of a floor are moved onto it here (vertices need not be snapped)."""
+    v = np.array(mesh_std_vertices, dtype=np.float64)
     f = np.asarray(faces, dtype=np.int64)
     levels = np.asarray(floors, dtype=np.float64)
+    v[:, 1] = _snap(v[:, 1], levels)
     out = []
     for lo, hi in zip(levels[:-1], levels[1:], strict=True):
         polygon = _outline(_section(v, f, (lo + hi) / 2.0))
         out.append(np.zeros((0, 2)) if polygon is None else _clean(polygon))
     return out
+
+
+def _snap(heights: np.ndarray, levels: np.ndarray) -> np.ndarray:
+    """Each height moved onto the nearest floor when it is within FLOOR_GAP of the span (the
+    vertical alignment of section 4.1); others are kept."""
+    if len(levels) == 0:
+        return heights
+    at = np.clip(np.searchsorted(levels, heights), 1, max(len(levels) - 1, 1))
+    below, above = levels[at - 1], levels[np.minimum(at, len(levels) - 1)]
+    nearest = np.where(np.abs(heights - below) <= np.abs(above - heights), below, above)
+    span = float(levels[-1] - levels[0])
+    return np.where(np.abs(heights - nearest) < FLOOR_GAP * max(span, 1e-300), nearest, heights)
 
 
 def _area(ring: np.ndarray) -> float:
@@ -190,7 +242,8 @@ def cut_floors(areas: np.ndarray) -> np.ndarray:
     * a plateau (r equal over several successive floors, within RATIO_EPS) that rises above both
       its neighbours cuts at each of its floors.  Deviation: read strictly, the paper's rule finds
       no cut in a ziggurat of equal steps (every r the same), which is several blocks plainly;
-    * an empty interval (area 0) gives r = inf at its floors.
+    * an empty interval (area 0) gives r = inf at its floors;
+    * a ratio below 1 + RATIO_NOISE is 1 (deviation: see RATIO_NOISE).
     """
     a = np.asarray(areas, dtype=np.float64)
     if len(a) < 2:
@@ -199,6 +252,7 @@ def cut_floors(areas: np.ndarray) -> np.ndarray:
     with np.errstate(divide="ignore", invalid="ignore"):
         r = np.where(small > 0, big / np.where(small > 0, small, 1.0), np.inf)
     r = np.where(big > 0, r, 1.0)  # two empty intervals: no change
+    r = np.where(r < 1.0 + RATIO_NOISE, 1.0, r)
     padded = np.concatenate([[1.0], r, [1.0]])
     # runs of equal ratios (plateaus), then each run compared with the runs beside it
     finite = np.where(np.isfinite(padded), padded, np.finfo(float).max)
