@@ -30,6 +30,7 @@ from PIL import Image
 from style_synth_specs import SPECS, Pattern
 
 import bgr
+from bgr.grammar.formatter import format_source
 
 PX_PER_M = 40
 """Texture resolution: a 2.5 cm pixel, every size in the specs a whole number of pixels."""
@@ -314,7 +315,7 @@ def _grammar(kind: int, blocks: list[BlockTruth], textured: bool, storey_faces: 
             else:
                 rules.append(head + piece)
     rules.append(f'Roof --> color("{ROOF}")')
-    return "\n".join(rules) + "\n"
+    return format_source("\n".join(rules) + "\n")  # in `bgr fmt`'s layout, to be read
 
 
 def make_building(
