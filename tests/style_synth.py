@@ -98,6 +98,12 @@ class WallFace:
                 runs.append((i, i))
         return runs
 
+    def rows(self) -> np.ndarray:
+        """(k, 2) bottom and top of each window row, world y, metres: one a storey that has
+        windows (what a vertical splitting rule C, D of section 4.3.4 finds)."""
+        rows = [(b.bottom + b.sill, b.bottom + b.head) for b in self.bands if b.windows]
+        return np.array(rows, dtype=float).reshape(-1, 2)
+
     def windows(self) -> np.ndarray:
         """(n, 4) every window as x0, x1 (from the face's left) and y0, y1 (world), metres."""
         rows = [

@@ -128,6 +128,9 @@ def test_window_counts_by_hand(buildings):
     # the L: front 28 / 3 = 9 bays; bar end 8.1 m / 4 = 2 pairs; bar back 16.8 / 3 = 5; wing
     # side 9.9 / 4 = 2 pairs; wing back 11.2 / 3 = 3; left 18 / 3 = 6; seven storeys
     assert counts(4, 1) == [63, 28, 35, 28, 21, 42]
+    # the podium's front: a shop row from 0.4 m to 3.7 m (0.8 under the 4.5 m ceiling), then
+    # windows from 0.3 of the 4 m upper storey for half its height: 4.5 + 1.2 to 4.5 + 1.2 + 2
+    np.testing.assert_allclose(buildings[4].blocks[0].faces[0].rows(), [[0.4, 3.7], [5.7, 7.7]])
     assert [f.wall for f in buildings[4].blocks[1].faces] == [
         "front",
         "right",
