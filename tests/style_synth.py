@@ -27,8 +27,10 @@ from pathlib import Path
 
 import numpy as np
 from PIL import Image
+from style_synth_specs import SPECS, Pattern
 
 import bgr
+from bgr.grammar.formatter import format_source
 
 PX_PER_M = 40
 """Texture resolution: a 2.5 cm pixel, every size in the specs a whole number of pixels."""
@@ -37,10 +39,7 @@ FRAME_M = 0.1  # a window's frame, inside its rectangle
 GLASS = np.array([46, 58, 74], np.uint8)
 FRAME = np.array([236, 234, 226], np.uint8)
 ROOF = "#7d7d7d"
-
-# A wall's window pattern: grid(), pairs(), shop() below, or BLANK (no windows).
-Pattern = tuple
-BLANK: Pattern = ("blank",)
+KINDS = len(SPECS)
 
 
 @dataclass
@@ -82,6 +81,28 @@ class WallFace:
     @property
     def window_count(self) -> int:
         return sum(band.windows for band in self.bands)
+
+    def stacks(self) -> list[tuple[int, int]]:
+        """Its vertically consistent groups (section 4.3.3), as (first, last) band indices:
+        runs of storeys with the same window columns (their rows may differ with the storey's
+        height).  Equal widths give phi_shape = 1 (eq. 1); equal columns correlate over 0.99
+        (eq. 2), a shop row and the grid above it 0.29 to 0.36 and a blank storey (noise) about
+        0 with anything, under the paper's 0.5; across a cut no wall's storeys correlate over
+        0.32 (tests/test_style_synth.py measures it all on the images)."""
+        runs: list[tuple[int, int]] = []
+        for i, band in enumerate(self.bands):
+            below = self.bands[i - 1] if i else None
+            if below and band.windows and np.array_equal(band.columns, below.columns):
+                runs[-1] = (runs[-1][0], i)
+            else:
+                runs.append((i, i))
+        return runs
+
+    def rows(self) -> np.ndarray:
+        """(k, 2) bottom and top of each window row, world y, metres: one a storey that has
+        windows (what a vertical splitting rule C, D of section 4.3.4 finds)."""
+        rows = [(b.bottom + b.sill, b.bottom + b.head) for b in self.bands if b.windows]
+        return np.array(rows, dtype=float).reshape(-1, 2)
 
     def windows(self) -> np.ndarray:
         """(n, 4) every window as x0, x1 (from the face's left) and y0, y1 (world), metres."""
@@ -184,86 +205,6 @@ def _vertical(pattern: Pattern, height: float) -> tuple[float, float]:
     if pattern[0] == "shop":
         return 0.4, _q(height - 0.8)
     return _q(0.3 * height), _q(0.3 * height) + _q(0.5 * height)
-
-
-def grid(pitch: float, width: float) -> Pattern:
-    """One window of ``width`` centred in each whole bay of ``pitch`` metres (a regular A)."""
-    return ("grid", pitch, width)
-
-
-def pairs(pitch: float, width: float, gap: float) -> Pattern:
-    """Two windows ``gap`` apart in each bay: the irregular rhythm B of section 4.3.4."""
-    return ("pairs", pitch, width, gap)
-
-
-def shop(pitch: float, width: float, upper: Pattern) -> Pattern:
-    """A row of wide shop windows on the block's ground storey, ``upper`` on the others."""
-    return ("shop", pitch, width, upper)
-
-
-@dataclass(frozen=True)
-class Spec:
-    """One block: its lot rectangle, storey heights, one pattern a wall (front, right, back,
-    left; an L's two right and two back faces share theirs) and its wall colour."""
-
-    x: float
-    z: float
-    w: float
-    d: float
-    storeys: tuple[float, ...]
-    walls: tuple[Pattern, Pattern, Pattern, Pattern]
-    colour: tuple[int, int, int]
-    shape: tuple | None = None  # ("L", a, b): footprint(L, a, b)
-
-
-# The buildings.  x is the long axis and every block is centred in x except the L (whose wall
-# area tilts the PCA axes of section 4.1's standard view by 12.7 degrees), so PCA finds x.
-_G4 = grid(4.0, 1.6)
-_PODIUM = (shop(4, 3, _G4), _G4, shop(4, 3, _G4), BLANK)
-_TIER = (grid(3.5, 1.4), grid(3.5, 1.4), pairs(5, 1.2, 0.6), BLANK)
-_BASE = (shop(5, 4, grid(5, 2)), grid(5, 2), grid(5, 2), grid(5, 2))
-_SHOPS = (shop(4.0, 3.2, grid(4.0, 1.8)),) + (grid(4.0, 1.8),) * 3
-_L = (grid(3, 1.2), pairs(4.0, 0.9, 0.4), grid(3, 1.2), grid(3, 1.2))
-SPECS: list[tuple[str, list[Spec]]] = [
-    # one block, a regular grid on every wall
-    ("box", [Spec(0, 0, 24, 12, (3.0,) * 6, (grid(3, 1.4), grid(3, 1.2)) * 2, (196, 170, 140))]),
-    # shops under a grid and a blank side; a tower of window pairs
-    (
-        "podium_tower",
-        [
-            Spec(0, 0, 32, 16, (4.5, 3.5), _PODIUM, (176, 160, 150)),
-            Spec(7, 3, 18, 10, (3.0,) * 8, (pairs(4.5, 1, 0.5), grid(2.5, 1)) * 2, (210, 206, 196)),
-        ],
-    ),
-    # three tiers, narrower windows higher up; pairs at the back and a blank left wall mid-way
-    (
-        "wedding_cake",
-        [
-            Spec(0, 0, 36, 20, (4.0,) * 3, (grid(4.0, 2.0),) * 4, (150, 120, 100)),
-            Spec(5, 3, 26, 14, (3.5,) * 4, _TIER, (190, 180, 160)),
-            Spec(10, 6, 16, 8, (3.0,) * 3, (grid(2.5, 0.9),) * 4, (220, 214, 200)),
-        ],
-    ),
-    # four blocks, each within the one below, a window width each
-    (
-        "four_stack",
-        [
-            Spec(0, 0, 30, 18, (4.5, 3.5), _BASE, (160, 150, 140)),
-            Spec(3, 2, 24, 14, (3.2,) * 3, (grid(3.0, 1.5),) * 4, (200, 190, 170)),
-            Spec(6, 4, 18, 10, (3.0,) * 4, (grid(2.4, 1.1),) * 4, (185, 195, 200)),
-            Spec(9, 6, 12, 6, (3.0,) * 2, (grid(2.0, 0.8),) * 4, (215, 205, 185)),
-        ],
-    ),
-    # an L (a bar along the front, a wing up the left side) on a podium with shops in front
-    (
-        "l_on_podium",
-        [
-            Spec(0, 0, 32, 22, (4.5, 4.0), _SHOPS, (170, 150, 135)),
-            Spec(2, 2, 28, 18, (3.0,) * 7, _L, (205, 195, 180), ("L", 0.4, 0.45)),
-        ],
-    ),
-]
-KINDS = len(SPECS)
 
 
 def _outline(x: float, z: float, w: float, d: float, shape: tuple | None) -> np.ndarray:
@@ -380,7 +321,7 @@ def _grammar(kind: int, blocks: list[BlockTruth], textured: bool, storey_faces: 
             else:
                 rules.append(head + piece)
     rules.append(f'Roof --> color("{ROOF}")')
-    return "\n".join(rules) + "\n"
+    return format_source("\n".join(rules) + "\n")  # in `bgr fmt`'s layout, to be read
 
 
 def make_building(
