@@ -795,9 +795,9 @@ def _under_ceiling(args, command: str, advice: str, run: Callable[[Any], int]) -
 def _infer(args) -> int:
     from .inverse.inputs import check_input
 
-    if args.kind in (None, "schema", "city", "boxes"):
-        check_input(args.input, args.kind)  # a photo or a binary file: say what is read
     kind = args.kind or _infer_kind(args.input)
+    if args.kind in (None, "schema", "city", "boxes") and kind != "style":
+        check_input(args.input, args.kind)  # a photo or a binary file: say what is read
     if kind == "city":
         from .inverse.city.command import run
 

@@ -20,7 +20,8 @@ TEXT_EXTENSIONS = (".json", ".bgr")
 READS = (
     "bgr infer reads --kind schema: a terminal list (.json, from bgr derive -o x.json), a "
     "captured model (.json) or a grammar (.bgr); --kind city: a 3D city (.obj, .ply, .glb, "
-    '.gltf, .city.json, .city.jsonl); --kind boxes: a box hierarchy (.json with a "root" box)'
+    '.gltf, .city.json, .city.jsonl); --kind boxes: a box hierarchy (.json with a "root" box); '
+    "--kind style: a textured building (.gml, .xml, .obj, .glb, .gltf)"
 )
 
 # magic numbers of the files people give by mistake: (prefix, what it is)

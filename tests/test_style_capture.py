@@ -325,7 +325,8 @@ def test_parts_sharing_a_wall_are_one_outline_among_many_small_ones():
     parts = [_box((6, 6, 10), (-2, 0, 5)), _box((4, 6, 10), (3, 0, 5))]
     parts += [_box((0.3, 0.3, 1), (x, 8, 0.5)) for x in np.linspace(-4.5, 4.5, 20)]
     capture, _ = capture_geometry(_mesh(parts), None)
-    np.testing.assert_allclose(capture.floors, [0.0, 0.1, 1.0])
+    # the sheds' 1 m slice is thinner than remesh.MIN_LEVEL (2 m): it joins the interval above
+    np.testing.assert_allclose(capture.floors, [0.0, 1.0])
     assert len(capture.blocks) == 1
     for ring in capture.contours:
         assert len(ring) == 4
@@ -346,3 +347,24 @@ def test_an_l_with_equal_arms_is_aligned_with_its_walls():
     edges = np.roll(ring, -1, axis=0) - ring
     assert len(ring) == 6 and np.all(np.min(np.abs(edges), axis=1) < 1e-9)
     np.testing.assert_allclose(capture.blocks[0].size, (2.0, 1.0, 2.0), atol=1e-9)
+
+
+def test_a_thin_level_joins_the_neighbour_whose_outline_it_resembles():
+    from bgr.inverse.style.remesh import thin_levels_merged
+
+    def square(area: float) -> np.ndarray:
+        s = np.sqrt(area) / 2
+        return np.array([(-s, -s), (s, -s), (s, s), (-s, s)])
+
+    # intervals 0-0.3 (area 4), 0.3-0.32 (area 4: a ledge's vertices), 0.32-0.6 and 0.6-1
+    # (area 1); least 0.2: the thin one joins the interval below, whose area it shares, so
+    # the floor at 0.3 goes and the cut at 0.32 stays
+    floors = np.array([0.0, 0.3, 0.32, 0.6, 1.0])
+    rings = [square(4), square(4), square(1), square(1)]
+    np.testing.assert_allclose(thin_levels_merged(floors, rings, 0.2), [0.0, 0.32, 0.6, 1.0])
+    # with the thin interval shaped like the one above, the floor at 0.32 goes instead
+    rings = [square(4), square(1), square(1), square(1)]
+    np.testing.assert_allclose(thin_levels_merged(floors, rings, 0.2), [0.0, 0.3, 0.6, 1.0])
+    # nothing thinner than least: unchanged; everything thin: one interval is left
+    np.testing.assert_allclose(thin_levels_merged(floors, rings, 0.01), floors)
+    assert list(thin_levels_merged(floors, rings, 2.0)) == [0.0, 1.0]

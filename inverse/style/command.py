@@ -55,12 +55,20 @@ def add_restyle_parser(commands, allow_help: str, add_memory_option) -> None:
         "onto it (equations 6-7; the bottom and top blocks take the source's bottom and top), "
         "and its walls are split by the sheet's rules.",
     )
-    restyle.add_argument("mass", metavar="MASS", help="the mass: .glb, .gltf or .obj")
+    restyle.add_argument("input", metavar="MASS", help="the mass: .glb, .gltf or .obj")
     restyle.add_argument("--style", required=True, metavar="STYLE.bgr", help="the style sheet")
     restyle.add_argument(
         "-o", "--output", required=True, metavar="OUT", help="the styled model (.glb, .obj, ...)"
     )
     restyle.add_argument("--seed", type=int, default=0, help="derivation seed (default 0)")
+    restyle.add_argument(
+        "--section",
+        type=int,
+        default=0,
+        metavar="N",
+        help="which captured building of a style sheet that holds several (its attr style; "
+        "default 0, the first)",
+    )
     restyle.add_argument(
         "--allow-path", action="append", default=[], metavar="DIR", help=allow_help
     )
@@ -121,7 +129,9 @@ def run_restyle(args) -> int:
     """``bgr restyle MASS --style STYLE.bgr -o OUT``."""
     from .restyle import restyle
 
-    result, report = restyle(args.mass, args.style, seed=args.seed, allow_paths=args.allow_path)
+    result, report = restyle(
+        args.input, args.style, seed=args.seed, section=args.section, allow_paths=args.allow_path
+    )
     result.save(args.output)
     print(
         f"{terminal_text(args.output, keep='')}: {report} ({len(result)} terminals)",

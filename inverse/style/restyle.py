@@ -108,6 +108,7 @@ def restyle(
     mass: str,
     style: str,
     seed: int = 0,
+    section: int = 0,
     allow_paths: Iterable[str | os.PathLike] = (),
 ):
     """The styled mass (a bgr.interpreter.derive.Result) and a one-line report."""
@@ -119,7 +120,24 @@ def restyle(
     from .remesh import capture_geometry
 
     grammar = load(style, allow_paths=allow_paths)
-    prefix = "S0" if "S0block0_width" in grammar.consts else ""
+    several = "S0block0_width" in grammar.consts
+    if (
+        section
+        and not several
+        or section < 0
+        or several
+        and f"S{section}block0_width" not in grammar.consts
+    ):
+        raise BgrError(
+            Diagnostic(
+                grammar.path,
+                0,
+                0,
+                f"--section {section}: the style sheet holds no captured building of that number",
+                "count its sections from 0 (its attr style)",
+            )
+        )
+    prefix = f"S{section}" if several else ""
     sources = source_blocks(grammar, prefix)
     mesh = read_model(mass)
     capture, frame = capture_geometry(mesh, None)
@@ -136,6 +154,7 @@ def restyle(
             footprint(
                 [(float(x), float(z)) for x, _, z in world],
                 {
+                    **({"style": section} if several else {}),
                     "block": matched[j],
                     "block_base": base,
                     "block_height": (block.top - block.bottom) * scale,
