@@ -114,11 +114,12 @@ def run_infer(args) -> int:
         else:
             write_text(output, text)
     faces = sum(len(c.capture.faces) for c in captured)
+    textured = sum(f.texture is not None for c in captured for f in c.capture.faces)
     blocks = sum(len(c.capture.blocks) for c in captured)
     wrote = "" if output is None else f"; wrote {terminal_text(str(output), keep='')}"
     print(
         f"{terminal_text(args.input, keep='')}: {len(captured)} buildings, {blocks} blocks, "
-        f"{faces} faces{wrote} and {len(files)} texture crops in "
+        f"{faces} faces ({textured} textured){wrote} and {len(files)} texture crops in "
         f"{terminal_text(str(assets_dir), keep='')}",
         file=sys.stderr,
     )

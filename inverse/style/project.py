@@ -31,7 +31,7 @@ import numpy as np
 import shapely
 
 from bgr.formats.textured_model import TexturedMesh, wrapped
-from bgr.grammar.errors import BgrError
+from bgr.grammar.errors import BgrError, Diagnostic
 from bgr.inverse.style.model import Face
 
 MAX_ANGLE = 30.0
@@ -172,10 +172,23 @@ class _Images:
         try:
             with open_image(mat.image_bytes()) as im:
                 return np.asarray(im.convert("RGB"), dtype=np.float32)
+        except BgrError:
+            raise
         except Exception as exc:  # Pillow raises many kinds for bytes that are no image
+            from PIL import UnidentifiedImageError
+
+            why = (
+                "it is not a PNG or JPEG image" if isinstance(exc, UnidentifiedImageError) else exc
+            )
             where = str(mat.image) if mat.image is not None else f"material {mat.name!r}"
             raise BgrError(
-                f"texture image {where} cannot be read: {exc}", self.mesh.source
+                Diagnostic(
+                    self.mesh.source,
+                    0,
+                    0,
+                    f"texture image {where} cannot be read: {why}",
+                    "replace the image with a readable PNG or JPEG, or remove it from the model",
+                )
             ) from None
 
 
