@@ -192,6 +192,15 @@ def test_cuts_at_local_maxima_of_the_area_ratio():
     assert list(cut_floors(np.array([16.0, 8.0, 4.0, 2.0]))) == [1, 2, 3]
 
 
+def test_every_setback_of_a_mass_is_a_cut():
+    # an untextured mass of four blocks (tests/style_synth.py's four_stack, one face a wall):
+    # its floors are its setbacks only, areas 30 x 18, 24 x 14, 18 x 10, 12 x 6, r = 1.61, 1.87,
+    # 2.5 -- growing, so only the last is a local maximum; each is over remesh.SETBACK (1.25)
+    assert list(cut_floors(np.array([540.0, 336.0, 180.0, 72.0]))) == [1, 2, 3]
+    # a taper under SETBACK keeps the paper's rule: r = 1.1, 1.2, 1.15, one cut at the 1.2
+    assert list(cut_floors(np.array([12.1, 11.0, 13.2, 15.18]))) == [2]
+
+
 def test_blocks_take_the_box_of_their_cut_interval():
     square = np.array([(-1, -1), (1, -1), (1, 1), (-1, 1)], dtype=float)
     rings = [square * 0.4, square * 0.4, square * 0.2, square * 0.19]

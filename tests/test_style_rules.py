@@ -267,6 +267,27 @@ def test_window_size_merges_a_window_cut_by_its_muntin() -> None:
 
 
 @pytest.mark.parametrize("axis", ["x", "y"])
+def test_a_blank_wall_has_no_window(axis: str) -> None:
+    # plaster with +-4 levels of grain: stretched to 0..1 its variance signal is all noise, and
+    # k-means and the labelling would cut it into dozens of one-pixel "windows"
+    rng = np.random.default_rng(5)
+    img = np.clip(205 + rng.integers(-4, 5, (300, 600, 1)), 0, 255).astype(np.uint8)
+    img = np.repeat(img, 3, axis=2)
+    rule = detect_rule(img, axis, 6.0)
+    assert rule.insertable == ()
+    assert rule.scalable == pytest.approx((6.0,))
+    # one faint window (glass 20 levels darker than the plaster) is still a window: a column
+    # through it is 0.27 glass, its variance p (1 - p) 20^2 * 3 / 255^2 = 3.6e-3; a row 0.1
+    # glass, 1.7e-3: both over PLAIN_VARIANCE (1e-3)
+    img[40:120, 200:260] -= 20
+    found = detect_rule(img, axis, 6.0)
+    assert found.m == 1
+    span = (2.0, 2.6) if axis == "x" else (3.6, 5.2)  # metres; y from the bottom (row 120)
+    first = sum(found.scalable[:1])
+    assert (first, first + found.insertable[0]) == pytest.approx(span, abs=0.03)
+
+
+@pytest.mark.parametrize("axis", ["x", "y"])
 def test_variance_signal_is_the_summed_channel_variance(axis: str) -> None:
     img = np.random.default_rng(3).integers(0, 256, (37, 53, 3), dtype=np.uint8)
     img[:, 5] = (10, 200, 30)  # one column of one colour

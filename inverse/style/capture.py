@@ -19,7 +19,7 @@ from bgr.grammar.errors import BgrError, Diagnostic
 from .emit import Crops, style_text
 from .groups import Groups, face_groups
 from .model import Capture
-from .project import face_textures
+from .project import face_textures, roof_color
 from .remesh import capture_geometry
 
 READERS = {
@@ -128,6 +128,7 @@ def capture_building(
     )
     vertices = frame.apply(mesh.vertices)
     face_textures(mesh, vertices, select, capture.faces, texels_per_unit)
+    capture.roof = roof_color(mesh, vertices, select)
     groups = face_groups(capture)
     return Captured(capture, groups, frame, time.perf_counter() - start)
 

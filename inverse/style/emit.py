@@ -34,11 +34,13 @@ import numpy as np
 from bgr.grammar.formatter import format_number, format_source, format_string
 from bgr.grammar.safe_text import comment_text
 
-from .groups import Groups, along
+from .groups import RIGHTWARD, Groups, along
 from .model import OUTWARD, WALLS, Block, Capture, Face
 
 MIN_PIECE = 0.001  # metres: a scalable piece this short still takes its share (no 0 / 0)
 RECESS = 0.02  # metres: a face set back less than this is flush with its wall
+PART = 0.98  # a comp(f) face narrower than this share of its side is one of several faces
+ROOF = "#9a9a9a"  # a roof's colour when the source's is unknown (a textured roof)
 
 
 def num(x: float, digits: int = 4) -> str:
@@ -51,21 +53,24 @@ class Crops:
     """The texture crops of a style sheet: PNG bytes by file name, each distinct crop once."""
 
     folder: str  # how the grammar names the assets folder (relative to the grammar)
-    max_size: int = 512  # each side at most this many pixels (--max-texture-size)
+    max_size: int = 512  # each side at most this many pixels, on its own (--max-texture-size)
     files: dict[str, bytes] = field(default_factory=dict)
     _names: dict[str, str] = field(default_factory=dict)
 
     def add(self, image: np.ndarray) -> str:
-        """The grammar's path of the PNG of ``image`` ((h, w, 3) uint8), written once."""
+        """The grammar's path of the PNG of ``image`` ((h, w, 3) uint8), written once.
+
+        Each side longer than ``max_size`` is shrunk on its own, by area averaging: a crop is
+        stretched once over its piece, so its aspect need not be kept, and a wall strip as wide
+        as its face and a few rows high (1,200 x 37 pixels) scaled as a whole would lose its
+        rows (16 left: a window frame's line smeared over the wall); averaging, unlike Lanczos,
+        rings no halo beside such a line."""
         from PIL import Image
 
         pil = Image.fromarray(np.ascontiguousarray(image), "RGB")
         if max(pil.size) > self.max_size:
-            k = self.max_size / max(pil.size)
-            pil = pil.resize(
-                (max(1, round(pil.width * k)), max(1, round(pil.height * k))),
-                Image.Resampling.LANCZOS,
-            )
+            size = (min(pil.width, self.max_size), min(pil.height, self.max_size))
+            pil = pil.resize(size, Image.Resampling.BOX)
         out = io.BytesIO()
         pil.save(out, "PNG", optimize=False)
         data = out.getvalue()
@@ -159,9 +164,15 @@ class _Sheet:
         self.index = {id(f): i for i, f in enumerate(groups.faces)}
         self.lines: list[str] = []
         self.consts: list[str] = []  # the source blocks' sizes, which bgr restyle matches
+        self.named: dict[int, str] = {}  # id(face) -> its rule, written once
 
     def face(self, face: Face) -> str:
-        """Rules of one face; returns its rule name."""
+        """Rules of one face (written on first use); returns its rule name."""
+        if id(face) not in self.named:
+            self.named[id(face)] = self._face(face)
+        return self.named[id(face)]
+
+    def _face(self, face: Face) -> str:
         i = self.index[id(face)]
         name = f"{self.p}F{i}"
         g = self.groups
@@ -261,6 +272,42 @@ class _Sheet:
         self.lines.append(f"{name}Levels(kh, kw) --> split(y) {{ {' | '.join(levels)} }}")
         return name
 
+    def side(self, b: int, block: Block, w: int, full_rule: str) -> str:
+        """The selector of comp(f)'s faces looking the way of wall ``w``: ``full_rule`` (the
+        whole wall, faces at relative widths, set-back ones recessed) for a face as wide as the
+        block's side, as a box mass or the lot's block gives; else, where the block's outline is
+        not a rectangle, one of its captured faces looking that way (a jog of an L included,
+        whichever wall section 4.3.1 filed it under), chosen by its share of the side's width.
+
+        Our addition: section 5.1.3 snaps a target's faces to the source's by dynamic time
+        warping along the wall; comp(f) hands a rule one face at a time, which knows its width
+        and not its place, so the width share is what a rule can match on.  On the source's own
+        mass (bgr restyle onto it) every face finds itself; on another L the nearest share."""
+        columns = side_columns(block, w)
+        metres = self.capture.scale
+        xmin, xmax, zmin, zmax = block.box
+        full = (xmax - xmin) if w in (0, 2) else (zmax - zmin)
+        shares = [float(np.hypot(*(first.end - first.start))) / full for first, _ in columns]
+        if len(columns) <= 1 and all(r >= PART for r in shares):
+            return full_rule
+        name = f"{full_rule}Side"
+        cases = [f"case scope.sx >= {num(PART)} * full: {full_rule}"]
+        order = np.argsort(shares, kind="stable")
+        for n_, j in enumerate(order):
+            part = f"{full_rule}Part{n_}"
+            pieces = []
+            for level, face in zip(block.levels, columns[j][1], strict=True):
+                span = (self.capture.floors[level + 1] - self.capture.floors[level]) * metres
+                pieces.append(f"~{num(span)}: {self.face(face) if face is not None else 'Plain'}")
+            self.lines.append(f"{part} --> split(y) {{ {' | '.join(pieces)} }}")
+            if n_ + 1 < len(order):
+                limit = (shares[j] + shares[order[n_ + 1]]) / 2.0
+                cases.append(f"case scope.sx < {num(limit)} * full: {part}")
+            else:
+                cases.append(f"else: {part}")
+        self.lines.append(f"{name}(full) --> " + " | ".join(cases))
+        return f"{name}({('bw', 'bd')[w % 2]})"
+
     def building(self) -> None:
         cap, p = self.capture, self.p
         xs = [v for b in cap.blocks for v in b.box[:2]]
@@ -276,7 +323,7 @@ class _Sheet:
                     mine = (-block.box[2], block.box[1], block.box[3], -block.box[0])[w]
                     theirs = (-above.box[2], above.box[1], above.box[3], -above.box[0])[w]
                     gap = (mine - theirs) * cap.scale if mine > theirs else None
-                walls.append(f"{WALLS[w]}: {self.wall(k, block, w, gap)}")
+                walls.append(f"{WALLS[w]}: {self.side(k, block, w, self.wall(k, block, w, gap))}")
             xmin, xmax, zmin, zmax = block.box
             fx, fz = (xmin - x0) / (x1 - x0), (zmin - z0) / (z1 - z0)
             sx, sz = (xmax - xmin) / (x1 - x0), (zmax - zmin) / (z1 - z0)
@@ -284,10 +331,12 @@ class _Sheet:
                 f"{p}Block{k} --> t('{num(fx)}, 0, '{num(fz)}) "
                 f"s('{num(sx)}, '1, '{num(sz)}) {p}Block{k}Mass"
             )
-            self.lines.append(
-                f"{p}Block{k}Mass --> comp(f) {{ {' | '.join(walls)} | top: {p}Roof "
-                "| bottom: NIL }"
-            )
+            faces = f"comp(f) {{ {' | '.join(walls)} | top: {p}Roof | bottom: NIL }}"
+            if "(bw)" in faces or "(bd)" in faces:  # the sides' full widths for ``side``
+                self.lines.append(f"{p}Block{k}Mass --> {p}Block{k}Faces(scope.sx, scope.sz)")
+                self.lines.append(f"{p}Block{k}Faces(bw, bd) --> {faces}")
+            else:
+                self.lines.append(f"{p}Block{k}Mass --> {faces}")
             parts.append(f"~{num((block.top - block.bottom) * cap.scale)}: {p}Block{k}")
             for what, size in zip(("width", "height", "depth"), block.size, strict=True):
                 self.consts.append(f"const {p}block{k}_{what} = {num(size * cap.scale)}")
@@ -296,7 +345,42 @@ class _Sheet:
             f"{p}Reveal(d) --> extrude(-d) comp(f) {{ side: reverseNormals() "
             'color("#8c8c8c") Plain | all: NIL }'
         )
-        self.lines.append(f'{p}Roof --> color("#9a9a9a") Plain')
+        roof = _hex(cap.roof) if cap.roof is not None else ROOF
+        self.lines.append(f'{p}Roof --> color("{roof}") Plain')
+
+
+def side_columns(block: Block, w: int) -> list[tuple[Face, list[Face | None]]]:
+    """The faces of ``block`` whose own outward normal is wall ``w``'s, as columns: one per such
+    face of its lowest level (left to right), with the face of every level (bottom first) that
+    overlaps it most along the wall (None where none does)."""
+    axis = RIGHTWARD[w]
+
+    def looks(f: Face) -> bool:
+        e = f.end - f.start
+        length = float(np.hypot(*e))
+        return length > 0 and float(e @ axis) / length > 0.99
+
+    def span(f: Face) -> tuple[float, float]:
+        a, b = float(f.start @ axis), float(f.end @ axis)
+        return (min(a, b), max(a, b))
+
+    def on(level: int) -> list[Face]:
+        return [f for faces in block.walls for f in faces if f.level == level and looks(f)]
+
+    out: list[tuple[Face, list[Face | None]]] = []
+    for first in sorted(on(block.levels[0]), key=lambda f: span(f)[0]):
+        a0, a1 = span(first)
+        column: list[Face | None] = []
+        for level in block.levels:
+            best, most = None, 0.0
+            for f in on(level):
+                b0, b1 = span(f)
+                overlap = min(a1, b1) - max(a0, b0)
+                if overlap > most:
+                    best, most = f, overlap
+            column.append(best)
+        out.append((first, column))
+    return out
 
 
 HEADER = """\
@@ -345,13 +429,17 @@ def style_text(sheets: list[tuple[Capture, Groups]], crops: Crops) -> str:
         out.append("Lot --> " + " | ".join(cases) + f" | else: {starts[-1][0]}Lot")
         for p, body in starts:
             out.append(f"{p}Lot --> {body}")
-    out.append("# a crop of a face's texture stretched once over the piece")
     out.append(
-        "Wall(file) --> setupProjection(0, scope.xy, '1, '1) projectUV(0) texture(file) WallTile"
+        "# a crop of a face's texture stretched once over the piece, in its own colours (a "
+        "shape's colour multiplies its texture, and bgr's default is a light grey)"
     )
     out.append(
-        "Window(file) --> setupProjection(0, scope.xy, '1, '1) projectUV(0) texture(file) "
-        "WindowTile"
+        "Wall(file) --> color(\"#ffffff\") setupProjection(0, scope.xy, '1, '1) projectUV(0) "
+        "texture(file) WallTile"
+    )
+    out.append(
+        "Window(file) --> color(\"#ffffff\") setupProjection(0, scope.xy, '1, '1) projectUV(0) "
+        "texture(file) WindowTile"
     )
     for k, lines in enumerate(sections):
         capture = sheets[k][0]

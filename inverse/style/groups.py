@@ -59,21 +59,48 @@ def along(face: Face) -> tuple[float, float]:
     return (min(a, b), max(a, b))
 
 
+def direction(face: Face) -> np.ndarray:
+    """The face's own left-to-right unit direction seen from outside, (x, z)."""
+    edge = np.asarray(face.end, dtype=np.float64) - np.asarray(face.start, dtype=np.float64)
+    length = float(np.hypot(edge[0], edge[1]))
+    return edge / length if length > 0 else np.zeros(2)
+
+
+def spans(lower: Face, upper: Face) -> tuple[tuple[float, float], tuple[float, float]]:
+    """The intervals two faces cover along the lower face's own left-to-right direction, or two
+    empty ones when they do not look the same way.
+
+    The face's own direction, not its wall's (``along``): a jog of an outline (the wing side of
+    an L) is filed under the wall whose bounding-box corners enclose it (section 4.3.1) and runs
+    square to it, so along that wall it covers nothing, and neither equation 1 nor 2 could link
+    it to the jog above it."""
+    axis = direction(lower)
+    if float(axis @ direction(upper)) < 0.99:
+        return (0.0, 0.0), (0.0, 0.0)
+
+    def span(f: Face) -> tuple[float, float]:
+        a, b = float(f.start @ axis), float(f.end @ axis)
+        return (min(a, b), max(a, b))
+
+    return span(lower), span(upper)
+
+
 def shape_similarity(lower: Face, upper: Face) -> float:
     """Equation 1: the width of the two faces' overlap over the narrower face's width."""
-    (a0, a1), (b0, b1) = along(lower), along(upper)
+    (a0, a1), (b0, b1) = spans(lower, upper)
     overlap = max(0.0, min(a1, b1) - max(a0, b0))
     narrower = min(a1 - a0, b1 - b0)
     return overlap / narrower if narrower > 0 else 0.0
 
 
-def column_signal(face: Face, lo: float, hi: float) -> np.ndarray | None:
+def column_signal(face: Face, lo: float, hi: float, span: tuple[float, float]) -> np.ndarray | None:
     """omega of equation 2: the face's pixel columns averaged (grey, 0..1), sampled at
-    SIGNAL_SAMPLES points of the stretch lo..hi of its wall; None when untextured."""
+    SIGNAL_SAMPLES points of the stretch lo..hi of the axis along which the face covers
+    ``span``; None when untextured."""
     if face.texture is None:
         return None
     grey = face.texture.astype(np.float64).mean(axis=2).mean(axis=0) / 255.0
-    a0, a1 = along(face)
+    a0, a1 = span
     at = (np.linspace(lo, hi, SIGNAL_SAMPLES) - a0) / max(a1 - a0, 1e-12)
     cols = np.clip((at * len(grey)).astype(np.int64), 0, len(grey) - 1)
     return grey[cols]
@@ -83,9 +110,9 @@ def texture_similarity(lower: Face, upper: Face) -> float:
     """Equation 2: the correlation of the two faces' column signals over their overlap.  Two
     untextured faces are alike (1); a textured and an untextured face are not (0); a flat
     signal correlates with another flat one only."""
-    (a0, a1), (b0, b1) = along(lower), along(upper)
+    (a0, a1), (b0, b1) = spans(lower, upper)
     lo, hi = max(a0, b0), min(a1, b1)
-    s, t = column_signal(lower, lo, hi), column_signal(upper, lo, hi)
+    s, t = column_signal(lower, lo, hi, (a0, a1)), column_signal(upper, lo, hi, (b0, b1))
     if s is None or t is None:
         return 1.0 if s is None and t is None else 0.0
     ds, dt = s - s.mean(), t - t.mean()

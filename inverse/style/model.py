@@ -81,6 +81,7 @@ class Capture:
     blocks: list[Block]
     source: str = ""  # the input file, as given
     warnings: list[str] = field(default_factory=list)
+    roof: tuple[int, int, int] | None = None  # the source roof's colour (None: unknown, grey)
 
     @property
     def faces(self) -> list[Face]:

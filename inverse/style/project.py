@@ -346,6 +346,34 @@ def _plain_color(
     return _rgb(np.array(tris.colors[int(tris.material[nearest])][:3]) * 255.0)
 
 
+ROOF_UP = 0.9
+"""A triangle is a roof when its unit normal's up component is above this (within about 26
+degrees of level): flat roofs and the gentle pitches of most Manhattan-world blocks."""
+
+
+def roof_color(
+    mesh: TexturedMesh, vertices: np.ndarray, select: np.ndarray
+) -> tuple[int, int, int] | None:
+    """The area-weighted mean sRGB colour (0..255) of the untextured roof triangles that
+    ``select`` keeps (``vertices`` in the standard frame, y up), or None when there are none.
+
+    The paper's style sheet holds the walls only; the roof is the shape layer's, and a style
+    sheet that paints it a fixed grey makes every derived building's roof another colour than
+    its source's.  Textured roofs are not sampled (None): their photographs are for the walls'
+    crops to carry, and the emitter keeps its grey."""
+    tris = _Triangles(mesh, np.asarray(vertices, dtype=np.float64), np.asarray(select, dtype=bool))
+    corners = tris.corners
+    area = 0.5 * np.linalg.norm(
+        np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0]), axis=1
+    )
+    roof = (tris.normal[:, 1] > ROOF_UP) & ~tris.textured & (area > 0)
+    if not roof.any():
+        return None
+    colors = np.array([c[:3] for c in tris.colors], dtype=np.float64).reshape(-1, 3)
+    mean = (colors[tris.material[roof]] * area[roof, None]).sum(axis=0) / area[roof].sum()
+    return _rgb(mean * 255.0)
+
+
 def _rgb(color: np.ndarray) -> tuple[int, int, int]:
     r, g, b = (int(v) for v in np.clip(np.rint(color), 0, 255))
     return (r, g, b)

@@ -45,6 +45,15 @@ are simplified (NEIGHBOURHOOD), so successive areas of one straight block differ
 10,000, and among such ratios every local maximum would be a cut.  1 % is above that noise
 (the simplification moves an outline's area by about 0.3 %) and far below a setback's change."""
 
+SETBACK = 1.25
+"""A floor-area ratio of at least this (a fifth of the area gone) is a cut whether or not it is
+a local maximum.  Deviation from section 4.2, whose cuts are the local maxima of the ratio
+alone: that rule picks one floor of a gradual taper, but on a model whose floors are its
+setbacks only (an untextured mass, one face a wall: bgr restyle's input; an LoD2 model without
+storey lines) every floor is a real change, and successive growing ratios (a four-step tower:
+1.61, 1.87, 2.5) would make one cut of three.  Floor-to-floor ratios of a taper stay well
+below 1.25 (tests/test_style_capture.py: 1.1 and 1.2 beside a 3 are not cuts)."""
+
 
 MIN_LEVEL = 2.0
 """Metres: the thinnest level (interval between two floors) a capture keeps.  Deviation from
@@ -280,7 +289,9 @@ def cut_floors(areas: np.ndarray) -> np.ndarray:
       its neighbours cuts at each of its floors.  Deviation: read strictly, the paper's rule finds
       no cut in a ziggurat of equal steps (every r the same), which is several blocks plainly;
     * an empty interval (area 0) gives r = inf at its floors;
-    * a ratio below 1 + RATIO_NOISE is 1 (deviation: see RATIO_NOISE).
+    * a ratio below 1 + RATIO_NOISE is 1 (deviation: see RATIO_NOISE);
+    * a ratio of SETBACK (1.25) or more is a cut, a local maximum or not (deviation: see
+      SETBACK).
     """
     a = np.asarray(areas, dtype=np.float64)
     if len(a) < 2:
@@ -298,7 +309,7 @@ def cut_floors(areas: np.ndarray) -> np.ndarray:
     value = finite[np.concatenate([[0], np.flatnonzero(step) + 1])]
     higher = np.zeros(len(value), dtype=bool)
     higher[1:-1] = (value[1:-1] > value[:-2]) & (value[1:-1] > value[2:])
-    return np.flatnonzero(higher[run[1:-1]]) + 1
+    return np.flatnonzero(higher[run[1:-1]] | (r >= SETBACK)) + 1
 
 
 def blocks(floors: np.ndarray, contours: list[np.ndarray]) -> list[Block]:

@@ -23,11 +23,12 @@ from itertools import accumulate
 
 import numpy as np
 
-from .signals import AXES, SIGNALS, edge_signal, variance_signal
+from .signals import AXES, SIGNALS, colour_variance, edge_signal, unit_range, variance_signal
 
 __all__ = [
     "AXES",
     "LAMBDA",
+    "PLAIN_VARIANCE",
     "SIGNALS",
     "Rule",
     "default_window",
@@ -47,6 +48,16 @@ __all__ = [
 
 LAMBDA = 0.025
 """Weight of the smoothness term of equation 3 (section 4.3.4: lambda = 0.025)."""
+
+PLAIN_VARIANCE = 1e-3
+"""A texture whose colour-variance signal (``colour_variance``, 0..1 units) spans less than
+this along the axis is a plain wall: no insertable section.  Deviation from section 4.3.4, whose
+k-means and labelling always find two clusters: the signal is stretched to 0..1 before
+labelling (so that lambda is scale-free), and on a blank wall that stretches its noise (a
+photograph's grain, JPEG blocks) into dozens of one-pixel "windows".  1e-3 is a change of
+standard deviation of about 5 grey levels a channel, a wall no one sees windows in; a blank
+synthetic wall with +-4 levels of grain spans 1.5e-4, a row of windows 0.14 to 0.25 and the
+Candler window tiles 0.17 to 0.19 (tests/test_style_rules.py, tests/test_style_roundtrip.py)."""
 
 SCALABLE, INSERTABLE = 0, 1
 """Labels l(i) of section 4.3.4: 0 a scalable element (wall), 1 an insertable one (window)."""
@@ -280,11 +291,17 @@ def detect_rule(
     (equation 3), the merge of fragments, and the rule scaled to ``length`` (the face's width
     for "x", height for "y").  ``window`` is the objective window size in the same unit as
     ``length`` (None: ``default_window``); ``signal`` "variance" is the paper's colour-variance
-    signal, "edges" the curtain-wall variant (``edge_signal``)."""
+    signal, "edges" the curtain-wall variant (``edge_signal``).  A texture whose raw variance
+    spans less than PLAIN_VARIANCE is a plain wall: one scalable section, no insertable."""
     if signal not in SIGNALS:
         raise ValueError(f"signal must be one of {sorted(SIGNALS)}, not {signal!r}")
-    values = SIGNALS[signal](image, axis)
-    labels = label_signal(values, lam)
+    if signal == "variance":
+        raw = colour_variance(image, axis)
+        values = unit_range(raw)
+        plain = float(np.ptp(raw)) < PLAIN_VARIANCE
+    else:
+        values, plain = SIGNALS[signal](image, axis), False
+    labels = np.zeros(values.size, np.int8) if plain else label_signal(values, lam)
     if window is not None:
         if not math.isfinite(window) or window < 0 or length <= 0:
             raise ValueError(f"the window size must be a finite number >= 0, not {window}")

@@ -46,7 +46,7 @@ def _channel_sums(img: np.ndarray, axis: str) -> tuple[np.ndarray, np.ndarray, i
     return first.astype(np.float64), second.astype(np.float64), count
 
 
-def _unit_range(values: np.ndarray) -> np.ndarray:
+def unit_range(values: np.ndarray) -> np.ndarray:
     """Min-max normalisation to 0..1 (a constant signal becomes all 0): lambda = 0.025 is then
     2.5 % of the signal's own range on every texture, whatever its contrast or size."""
     lo, hi = float(values.min()), float(values.max())
@@ -55,20 +55,26 @@ def _unit_range(values: np.ndarray) -> np.ndarray:
     return (values.astype(np.float64) - lo) / (hi - lo)
 
 
+def colour_variance(image: np.ndarray, axis: str) -> np.ndarray:
+    """The raw colour variance of each column (axis "x") or row (axis "y", top first): the sum
+    over R, G, B of the variance of that channel's values, in 0..1 units (0 for one colour, at
+    most 0.75).  ``variance_signal`` is this stretched to 0..1."""
+    img = _image(image, axis)
+    first, second, count = _channel_sums(img, axis)
+    variance = second / count - (first / count) ** 2  # E[v^2] - E[v]^2, per channel
+    return np.maximum(variance, 0.0).sum(axis=-1) / 255.0**2
+
+
 def variance_signal(image: np.ndarray, axis: str) -> np.ndarray:
     """The discrete colour-variance signal var(i) of section 4.3.4 (Figure 9, top).
 
     Axis "x" gives one value per image column (for a horizontal splitting rule: widths along
     x), axis "y" one per row, top first (a vertical rule).  The colour variance of a column is
     the sum over R, G, B of the variance of that channel's values down the column, in 0..1
-    units (0 for a column of one colour, at most 0.75); a column that crosses both wall and
-    window varies, a column of plain wall does not (the paper's key assumption).  The signal is
-    then stretched to 0..1 (``_unit_range``) so the paper's lambda means the same on every
-    texture."""
-    img = _image(image, axis)
-    first, second, count = _channel_sums(img, axis)
-    variance = second / count - (first / count) ** 2  # E[v^2] - E[v]^2, per channel
-    return _unit_range(np.maximum(variance, 0.0).sum(axis=-1) / 255.0**2)
+    units (``colour_variance``); a column that crosses both wall and window varies, a column of
+    plain wall does not (the paper's key assumption).  The signal is then stretched to 0..1
+    (``unit_range``) so the paper's lambda means the same on every texture."""
+    return unit_range(colour_variance(image, axis))
 
 
 def edge_signal(image: np.ndarray, axis: str) -> np.ndarray:
@@ -99,7 +105,7 @@ def edge_signal(image: np.ndarray, axis: str) -> np.ndarray:
     if box > 1:
         padded = np.pad(per, box // 2, mode="edge")
         per = np.convolve(padded, np.full(box, 1.0 / box), mode="valid")
-    return 1.0 - _unit_range(per)
+    return 1.0 - unit_range(per)
 
 
 SIGNALS = {"variance": variance_signal, "edges": edge_signal}
