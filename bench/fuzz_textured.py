@@ -564,6 +564,8 @@ def _glb_image_bytes(rng: random.Random, data: bytes, doc_bytes: bytes, json_len
         length = int(view["byteLength"])
     except fm.SHAPE_ERRORS:
         return fm.mutate_bytes(rng, data)
+    if not 0 <= start <= start + length <= len(data):  # a view an earlier mutation made lie:
+        return fm.mutate_bytes(rng, data)  # padding to its length once asked for 10^18 bytes
     image = mutate_image(rng, data[start : start + length])[:length]
     image += b"\x00" * (length - len(image))
     return data[:start] + image + data[start + length :]
