@@ -7,15 +7,25 @@ into the source's blocks at their relative heights, sets each block back as the 
 front, right, back and left): the wall's levels at their relative heights, each level's faces at
 their relative widths, a face set back from the block's outer boundary recessed by its depth.
 
-Each face is cut along y by its level's vertical rule and each window row along x by its
-stack's horizontal rule, both **exactly as equations 8 and 9** (section 5.2.3), in the
-grammar's own terms so that any mass can take it:
+Each face is cut along y by its level group's vertical rule and each window row along x by its
+stack group's horizontal rule, both **exactly as equations 8 and 9** (section 5.2.3), in the
+grammar's own terms so that any mass can take it.  The equations are written once per number m
+of insertable pieces, the sizes and crops being parameters:
 
-    F --> FFit(floor(scope.sx / P))                 x: whole repeats of the pattern
-    FFit(x) --> case scope.sx - x * P >= b1 + b2: FRun(x, 2, Sr) | ... | else: FRun(x, 0, Sr)
-    FRun(x, y, sr) --> case x > 0: split(x) { a1 * sr: .. | b1: .. | .. | ~1: FRun(x - 1, y, sr) }
-                     | case y == 2: split(x) { ~a1: .. | b1: .. | ~a2: .. | b2: .. | ~a3: .. }
-                     | ...                          the tail [b1 .. by] with [a1 .. a(y+1)]
+    SplitX2(a0, a1, a2, b0, b1, p, c1, c2, d0, d1, d2, s0, s1, s2, i0, i1) -->
+        SplitX2Fit(.., floor(scope.sx / p))                 x whole patterns of length p
+    SplitX2Fit(.., x) --> case scope.sx - x * p >= c2: SplitX2Run(.., x, 2, Sr) | ..
+    SplitX2Run(.., x, y, sr) --> case x > 0: split(x) { a0 * sr: Wall(s0) | b0: Window(i0) | ..
+                                                        | ~1: SplitX2Run(.., x - 1, y, sr) }
+        | else: split(x) { ~a0: Wall(s0) | (y > 0 ? b0 : 0): Window(i0) | .. }   the tail
+
+(c_y and d_y the sums of b0 .. b(y-1) and a0 .. ay, see :func:`split_rules`).  A group's rule
+is one line of its numbers (``Bays3(s0, s1, i0) --> SplitX1(0.8, 0.8, 1.2, 2.8, 1.2, 0.8, 1.6,
+s0, s1, i0)``), and a face one line of its crops per window row (``F7Row0 --> Bays3("..", "..",
+"..")``; along y the window rows are rules handed to the group's rule).  So the text grows with
+the crops, not with faces x pieces x tail cases: PLATEAU's 10 buildings took 22,900 lines
+(parsing and formatting them was most of a capture's time) and take 4,300, deriving the same
+meshes (benchmarked in bench/style.py, docs/benchmarks.md).
 
 Sizes are metres: windows (insertable pieces) keep the size they had, walls (scalable pieces)
 stretch by Sr.  Every piece shows its crop of the face's own texture (``Window("...")`` or
@@ -27,6 +37,7 @@ from __future__ import annotations
 
 import hashlib
 import io
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -36,6 +47,7 @@ from bgr.grammar.safe_text import comment_text
 
 from .groups import Groups, along
 from .model import OUTWARD, WALLS, Block, Capture, Face
+from .rules import Rule
 
 MIN_PIECE = 0.001  # metres: a scalable piece this short still takes its share (no 0 / 0)
 RECESS = 0.02  # metres: a face set back less than this is flush with its wall
@@ -86,60 +98,71 @@ def _pixels(cuts: list[tuple[str, float, float]], n: int) -> list[tuple[str, int
     return out
 
 
-def fit_rules(
-    name: str,
-    axis: str,
-    scalable: tuple[float, ...],
-    insertable: tuple[float, ...],
-    scalable_piece: list[str],
-    insertable_piece: list[str],
-    params: tuple[str, ...] = (),
-) -> list[str]:
-    """Rules realising split_h / split_v (equations 8-9) of a rule A (scalable), B (insertable)
-    along ``axis``: ``name(params)`` fills its scope with x whole patterns and the tail."""
+def split_sizes(scalable: Sequence[float], insertable: Sequence[float]) -> list[str]:
+    """The numbers a group hands its Split rule: A (a0 .. am, each at least MIN_PIECE), B (b0 ..
+    b(m-1)), the pattern's length P, the sums c1 .. cm of b0 .. b(y-1) and d0 .. dm of a0 ..
+    ay.  The sums are rounded here, once, like the sizes: summed by the grammar they would
+    carry float error, and a target exactly as wide as a sum (the source's own mass) would
+    fall on either side of an equation 8 comparison."""
     a = [max(MIN_PIECE, v) for v in scalable]
     b = list(insertable)
-    m = len(b)
+    sums = [sum(a) + sum(b)] + [sum(b[:y]) for y in range(1, len(b) + 1)]
+    sums += [sum(a[: y + 1]) for y in range(len(a))]
+    return [num(v) for v in a + b + sums]
+
+
+def split_rules(axis: str, m: int) -> list[str]:
+    """Equations 8-9 (split_h along x, split_v along y) once for every rule of ``m >= 1``
+    insertable pieces: ``SplitX<m>(a0 .. am, b0 .. b(m-1), p, c1 .. cm, d0 .. dm, s0 .. sm,
+    i0 .. i(m-1))`` takes the sizes of A (scalable, metres) and B (insertable) and their sums
+    (:func:`split_sizes`), the crops of the scalable pieces (``Wall(s)``) and the insertable
+    pieces: crops of windows along x (``Window(i)``), the window rows' rules along y.  A group's
+    rule is then one line of its numbers, and a face's one line of its crops.
+
+    ``..Fit`` takes x = floor(W / P) whole patterns and the largest tail y whose insertable
+    pieces b0 .. b(y-1) fit what is left, Sr filling the scope (ties in the window count go to
+    the layout whose walls stretch least, as before); ``..Run`` lays the whole patterns one by
+    one, then the tail [a0 b0 .. a(y-1) b(y-1) ay] as one split whose pieces beyond y have size
+    0 (a split makes no shape of size 0), so the text grows with m, not m^2."""
+    a = [f"a{k}" for k in range(m + 1)]
+    b = [f"b{k}" for k in range(m)]
+    c = [f"c{k}" for k in range(1, m + 1)]  # c_y = b0 + .. + b(y-1)
+    d = [f"d{k}" for k in range(m + 1)]  # d_y = a0 + .. + ay
+    s = [f"s{k}" for k in range(m + 1)]
+    i = [f"i{k}" for k in range(m)]
+    scalable = [f"Wall({v})" for v in s]
+    inserted = [f"Window({v})" for v in i] if axis == "x" else i
+    name = f"Split{axis.upper()}{m}"
+    lead = ", ".join(a + b + ["p"] + c + d + s + i)
     size = f"scope.s{axis}"
-    head = ", ".join(params)
-    lead = head + ", " if head else ""
-    if m == 0:  # no insertable element: one scalable piece stretched over the whole scope
-        return [f"{name}{_params(params)} --> {scalable_piece[0]}"]
-    pattern = num(sum(a) + sum(b))
+    sum_a, sum_b = d[m], c[m - 1]
     cases = []
     for y in range(m, -1, -1):
-        rest = f"{size} - x * {pattern}"
-        fill = f"{size} - x * {num(sum(b))} - {num(sum(b[:y]))}"
-        sr = f"({fill}) / (x * {num(sum(a))} + {num(sum(a[: y + 1]))})"
+        fill = f"{size} - x * {sum_b} - {c[y - 1]}" if y else f"{size} - x * {sum_b}"
+        sr = f"({fill}) / (x * {sum_a} + {d[y]})"
         if y == 0:  # a tie in the window count: the layout whose walls stretch least
-            alt = f"({size} - x * {num(sum(b))}) / (x * {num(sum(a))})"
-            cases.append(
-                f"case x > 0 and abs({alt} - 1) < abs({sr} - 1): {name}Run({lead}x - 1, {m}, {alt})"
-            )
-        guard = f"case {rest} >= {num(sum(b[:y]))}: " if y else "else: "
-        cases.append(f"{guard}{name}Run({lead}x, {y}, {sr})")
-    whole = [f"{num(a[0])} * sr: {scalable_piece[0]}"]
-    for i in range(m):
-        whole += [
-            f"{num(b[i])}: {insertable_piece[i]}",
-            f"{num(a[i + 1])} * sr: {scalable_piece[i + 1]}",
+            alt = f"({size} - x * {sum_b}) / (x * {sum_a})"
+            fewer = f"{name}Run({lead}, x - 1, {m}, {alt})"
+            cases.append(f"case x > 0 and abs({alt} - 1) < abs({sr} - 1): {fewer}")
+        guard = f"case {size} - x * p >= {c[y - 1]}: " if y else "else: "
+        cases.append(f"{guard}{name}Run({lead}, x, {y}, {sr})")
+    whole = [f"{a[0]} * sr: {scalable[0]}"]
+    tail = [f"~{a[0]}: {scalable[0]}"]
+    for k in range(m):
+        whole += [f"{b[k]}: {inserted[k]}", f"{a[k + 1]} * sr: {scalable[k + 1]}"]
+        tail += [
+            f"(y > {k} ? {b[k]} : 0): {inserted[k]}",
+            f"~(y > {k} ? {a[k + 1]} : 0): {scalable[k + 1]}",
         ]
+    whole.append(f"~1: {name}Run({lead}, x - 1, y, sr)")
     runs = [
-        f"case x > 0: split({axis}) {{ {' | '.join(whole)} | ~1: {name}Run({lead}x - 1, y, sr) }}"
+        f"case x > 0: split({axis}) {{ {' | '.join(whole)} }}",
+        f"else: split({axis}) {{ {' | '.join(tail)} }}",
     ]
-    for y in range(m, -1, -1):
-        tail = [f"~{num(a[0])}: {scalable_piece[0]}"]
-        for i in range(y):
-            tail += [
-                f"{num(b[i])}: {insertable_piece[i]}",
-                f"~{num(a[i + 1])}: {scalable_piece[i + 1]}",
-            ]
-        guard = f"case y == {y}: " if y else "else: "
-        runs.append(f"{guard}split({axis}) {{ {' | '.join(tail)} }}")
     return [
-        f"{name}{_params(params)} --> {name}Fit({lead}floor({size} / {pattern}))",
-        f"{name}Fit({lead}x) --> " + " | ".join(cases),
-        f"{name}Run({lead}x, y, sr) --> " + " | ".join(runs),
+        f"{name}({lead}) --> {name}Fit({lead}, floor({size} / p))",
+        f"{name}Fit({lead}, x) --> " + " | ".join(cases),
+        f"{name}Run({lead}, x, y, sr) --> " + " | ".join(runs),
     ]
 
 
@@ -154,72 +177,79 @@ def _hex(color: tuple[int, int, int]) -> str:
 class _Sheet:
     """Writes one building's section; ``p`` prefixes its rule names."""
 
-    def __init__(self, capture: Capture, groups: Groups, crops: Crops, p: str) -> None:
+    def __init__(
+        self, capture: Capture, groups: Groups, crops: Crops, p: str, splits: set[tuple[str, int]]
+    ) -> None:
         self.capture, self.groups, self.crops, self.p = capture, groups, crops, p
         self.index = {id(f): i for i, f in enumerate(groups.faces)}
         self.lines: list[str] = []
         self.consts: list[str] = []  # the source blocks' sizes, which bgr restyle matches
+        self.shared: list[str] = []  # the groups' rules, each written once
+        self.written: set[str] = set()
+        self.splits = splits  # (axis, m) of every Split rule the groups call
+
+    def group_rule(self, name: str, axis: str, rule: Rule) -> str:
+        """One group's rule, written once for all its faces: ``name(s0 .., i0 ..) -->
+        Split<axis><m>(its sizes, s0 .., i0 ..)``, the crops (or, along y, the window rows'
+        rules) being the face's parameters.  Along x a group without windows is one wall."""
+        if name in self.written:
+            return name
+        self.written.add(name)
+        m = len(rule.insertable)
+        s = [f"s{k}" for k in range(m + 1)]
+        i = [f"i{k}" for k in range(m)]
+        if m == 0:
+            self.shared.append(f"{name}(s0) --> Wall(s0)")
+            return name
+        self.splits.add((axis, m))
+        args = ", ".join(split_sizes(rule.scalable, rule.insertable) + s + i)
+        self.shared.append(f"{name}({', '.join(s + i)}) --> Split{axis.upper()}{m}({args})")
+        return name
 
     def face(self, face: Face) -> str:
-        """Rules of one face; returns its rule name."""
+        """Rules of one face; returns its rule name.  The face calls its level group's rows
+        rule with its own crops, each window row calling its stack group's bays rule with that
+        row's crops: the face's text is its crops, the splitting is its groups'."""
         i = self.index[id(face)]
         name = f"{self.p}F{i}"
         g = self.groups
-        rows, columns = g.rows[g.horizontal[i]], g.columns[g.vertical[i]]
+        h, v = g.horizontal[i], g.vertical[i]
+        rows, columns = g.rows[h], g.columns[v]
         metres = self.capture.scale
         self.lines.append(
             f"# {WALLS[face.wall]} wall, level {face.level}: {num(face.width * metres, 2)} x "
             f"{num(face.height * metres, 2)} m, {len(rows.insertable)} window rows of "
-            f"{len(columns.insertable)} bays (rows: group {g.horizontal[i]}, bays: group "
-            f"{g.vertical[i]})"
+            f"{len(columns.insertable)} bays (rows: group {h}, bays: group {v})"
         )
         texture = face.texture
         if texture is None:
             self.lines.append(f'{name} --> color("{_hex(face.color)}") Plain')
             return name
-        h, w = texture.shape[:2]
-        row_px = _pixels(g.row_cuts[g.horizontal[i]], h)[::-1]  # bottom to top, as C and D
-        col_px = _pixels(g.column_cuts[g.vertical[i]], w)
+        th, tw = texture.shape[:2]
+        row_px = _pixels(g.row_cuts[h], th)[::-1]  # bottom to top, as C and D
+        col_px = _pixels(g.column_cuts[v], tw)
         if not rows.insertable:  # no window row: the bays run the face's full height
-            row_px = [("insertable", 0, h)]
+            row_px = [("insertable", 0, th)]
         bands = [(r0, r1) for kind, r0, r1 in row_px if kind == "scalable"]
         lines = [(r0, r1) for kind, r0, r1 in row_px if kind == "insertable"]
+        walls = [(c0, c1) for kind, c0, c1 in col_px if kind == "scalable"]
+        bays = [(c0, c1) for kind, c0, c1 in col_px if kind == "insertable"]
 
         def crop(r: tuple[int, int], c: tuple[int, int]) -> str:
             return format_string(self.crops.add(texture[r[0] : r[1], c[0] : c[1]]))
 
-        walls = [(c0, c1) for kind, c0, c1 in col_px if kind == "scalable"]
-        bays = [(c0, c1) for kind, c0, c1 in col_px if kind == "insertable"]
-        cols = f"{name}Bays"
-        many = len(lines) > 1
-
-        def piece(kind: str, c: tuple[int, int], k: int) -> str:
-            if many:
-                return f"{cols}{kind}{k}(row)"
-            return f"{kind}({crop(lines[0], c)})"
-
-        if rows.insertable:
-            row_pieces = [f"Wall({crop(r, (0, w))})" for r in bands]
-            line_pieces = [f"{cols}({j})" if many else cols for j in range(len(lines))]
-            self.lines += fit_rules(
-                name, "y", rows.scalable, rows.insertable, row_pieces, line_pieces
-            )
-        else:
-            self.lines.append(f"{name} --> {cols}")
-        params = ("row",) if many else ()
-        wall_pieces = [piece("Wall", c, k) for k, c in enumerate(walls)]
-        bay_pieces = [piece("Window", c, k) for k, c in enumerate(bays)]
-        self.lines += fit_rules(
-            cols, "x", columns.scalable, columns.insertable, wall_pieces, bay_pieces, params
-        )
-        if many:  # one rule per piece of the pattern, choosing its crop by window row
-            for kind, spans in (("Wall", walls), ("Window", bays)):
-                for k, c in enumerate(spans):
-                    options = [
-                        f"case row == {j}: {kind}({crop(r, c)})" for j, r in enumerate(lines[:-1])
-                    ]
-                    options.append(f"else: {kind}({crop(lines[-1], c)})")
-                    self.lines.append(f"{cols}{kind}{k}(row) --> " + " | ".join(options))
+        bays_rule = self.group_rule(f"{self.p}Bays{v}", "x", columns)
+        calls = [
+            f"{bays_rule}({', '.join([crop(r, c) for c in walls] + [crop(r, c) for c in bays])})"
+            for r in lines
+        ]
+        if not rows.insertable:
+            self.lines.append(f"{name} --> {calls[0]}")
+            return name
+        args = [crop(r, (0, tw)) for r in bands] + [f"{name}Row{j}" for j in range(len(lines))]
+        rows_rule = self.group_rule(f"{self.p}Rows{h}", "y", rows)
+        self.lines.append(f"{name} --> {rows_rule}({', '.join(args)})")
+        self.lines += [f"{name}Row{j} --> {call}" for j, call in enumerate(calls)]
         return name
 
     def wall(self, b: int, block: Block, w: int, below_gap: float | None) -> str:
@@ -311,10 +341,11 @@ def style_text(sheets: list[tuple[Capture, Groups]], crops: Crops) -> str:
     out = [HEADER, "version 1", ""]
     sections: list[list[str]] = []
     sheet_consts: list[list[str]] = []
+    splits: set[tuple[str, int]] = set()
     for k, (capture, groups) in enumerate(sheets):
-        sheet = _Sheet(capture, groups, crops, f"S{k}" if len(sheets) > 1 else "")
+        sheet = _Sheet(capture, groups, crops, f"S{k}" if len(sheets) > 1 else "", splits)
         sheet.building()
-        sections.append(sheet.lines)
+        sections.append(sheet.shared + sheet.lines)
         sheet_consts.append(sheet.consts)
     first = sheets[0][0]
     if len(sheets) > 1:
@@ -353,6 +384,11 @@ def style_text(sheets: list[tuple[Capture, Groups]], crops: Crops) -> str:
         "Window(file) --> setupProjection(0, scope.xy, '1, '1) projectUV(0) texture(file) "
         "WindowTile"
     )
+    out.append(
+        "# equations 8 and 9: a group's sizes, then its pieces' crops (along y: its window rows)"
+    )
+    for axis, m in sorted(splits):
+        out += split_rules(axis, m)
     for k, lines in enumerate(sections):
         capture = sheets[k][0]
         out.append("")
