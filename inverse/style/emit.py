@@ -42,8 +42,15 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from bgr.grammar.formatter import format_number, format_source, format_string
-from bgr.grammar.safe_text import comment_text
+from bgr.grammar.formatter import (
+    HEAD_WIDTH,
+    INDENT,
+    WIDTH,
+    format_number,
+    format_source,
+    format_string,
+)
+from bgr.grammar.safe_text import comment_line, comment_text
 
 from .groups import Groups, along
 from .model import OUTWARD, WALLS, Block, Capture, Face
@@ -79,7 +86,7 @@ class Crops:
                 Image.Resampling.LANCZOS,
             )
         out = io.BytesIO()
-        pil.save(out, "PNG", optimize=False)
+        pil.save(out, "PNG", compress_level=1)  # 5 % larger than zlib 6, half the time
         data = out.getvalue()
         key = hashlib.sha256(data).hexdigest()
         if key not in self._names:
@@ -174,6 +181,52 @@ def _hex(color: tuple[int, int, int]) -> str:
     return "#" + "".join(f"{int(c):02x}" for c in color)
 
 
+class _Raw(str):
+    """A line already in the formatter's layout (bgr fmt): a declaration, a comment or a rule of
+    one successor whose head is within HEAD_WIDTH columns (the formatter keeps such a rule on
+    one line however long).  The style sheet's bulk -- the faces' crop lines -- is written so,
+    and only the other rules go through the parser and the formatter: parsing the bulk back
+    was most of a capture's time.  tests/test_style_emit.py checks that bgr fmt leaves the
+    whole sheet unchanged."""
+
+
+def _comment(text: str) -> _Raw:
+    return _Raw(comment_line(text))
+
+
+def _render(lines: list[str]) -> str:
+    """The sheet's text: runs of lines that are not _Raw formatted by format_source, the _Raw
+    ones as they are."""
+    out: list[str] = []
+    run: list[str] = []
+
+    def flush() -> None:
+        if run:
+            out.append(format_source("\n".join(run) + "\n", "<style sheet>").rstrip("\n"))
+            run.clear()
+
+    for line in lines:
+        if isinstance(line, _Raw):
+            flush()
+            out.append(line)
+        else:
+            run.append(line)
+    flush()
+    return "\n".join(out) + "\n"
+
+
+def _block_rule(head: str, entries: list[str]) -> _Raw:
+    """``head { e1 | e2 .. }`` in the formatter's layout: one line when it fits in its width,
+    else one entry a line, each after the first behind ``| ``.  ``head`` is a rule head of at
+    most HEAD_WIDTH columns and one operation that takes the block, the entries formatted."""
+    line = f"{head} {{ {' | '.join(entries)} }}"
+    if len(line) <= WIDTH:
+        return _Raw(line)
+    rows = [f"{head} {{", f"{INDENT}{entries[0]}"]
+    rows += [f"{INDENT}| {e}" for e in entries[1:]]
+    return _Raw("\n".join(rows + ["}"]))
+
+
 class _Sheet:
     """Writes one building's section; ``p`` prefixes its rule names."""
 
@@ -199,11 +252,13 @@ class _Sheet:
         s = [f"s{k}" for k in range(m + 1)]
         i = [f"i{k}" for k in range(m)]
         if m == 0:
-            self.shared.append(f"{name}(s0) --> Wall(s0)")
+            self.shared.append(_Raw(f"{name}(s0) --> Wall(s0)"))
             return name
         self.splits.add((axis, m))
         args = ", ".join(split_sizes(rule.scalable, rule.insertable) + s + i)
-        self.shared.append(f"{name}({', '.join(s + i)}) --> Split{axis.upper()}{m}({args})")
+        head = f"{name}({', '.join(s + i)})"
+        line = f"{head} --> Split{axis.upper()}{m}({args})"
+        self.shared.append(_Raw(line) if len(head + " -->") <= HEAD_WIDTH else line)
         return name
 
     def face(self, face: Face) -> str:
@@ -217,13 +272,15 @@ class _Sheet:
         rows, columns = g.rows[h], g.columns[v]
         metres = self.capture.scale
         self.lines.append(
-            f"# {WALLS[face.wall]} wall, level {face.level}: {num(face.width * metres, 2)} x "
-            f"{num(face.height * metres, 2)} m, {len(rows.insertable)} window rows of "
-            f"{len(columns.insertable)} bays (rows: group {h}, bays: group {v})"
+            _comment(
+                f"# {WALLS[face.wall]} wall, level {face.level}: {num(face.width * metres, 2)} x "
+                f"{num(face.height * metres, 2)} m, {len(rows.insertable)} window rows of "
+                f"{len(columns.insertable)} bays (rows: group {h}, bays: group {v})"
+            )
         )
         texture = face.texture
         if texture is None:
-            self.lines.append(f'{name} --> color("{_hex(face.color)}") Plain')
+            self.lines.append(_Raw(f'{name} --> color("{_hex(face.color)}") Plain'))
             return name
         th, tw = texture.shape[:2]
         row_px = _pixels(g.row_cuts[h], th)[::-1]  # bottom to top, as C and D
@@ -244,12 +301,12 @@ class _Sheet:
             for r in lines
         ]
         if not rows.insertable:
-            self.lines.append(f"{name} --> {calls[0]}")
+            self.lines.append(_Raw(f"{name} --> {calls[0]}"))
             return name
         args = [crop(r, (0, tw)) for r in bands] + [f"{name}Row{j}" for j in range(len(lines))]
         rows_rule = self.group_rule(f"{self.p}Rows{h}", "y", rows)
-        self.lines.append(f"{name} --> {rows_rule}({', '.join(args)})")
-        self.lines += [f"{name}Row{j} --> {call}" for j, call in enumerate(calls)]
+        self.lines.append(_Raw(f"{name} --> {rows_rule}({', '.join(args)})"))
+        self.lines += [_Raw(f"{name}Row{j} --> {call}") for j, call in enumerate(calls)]
         return name
 
     def wall(self, b: int, block: Block, w: int, below_gap: float | None) -> str:
@@ -273,22 +330,22 @@ class _Sheet:
                     d = f"{num(depth)} * kh"
                     if below_gap is not None and depth < below_gap:  # the overhang fix (5.1.2)
                         d = f"min({d}, 0.9 * {num(below_gap)} * kw)"
+                    back = f"-{d}" if d.startswith("min(") else f"-({d})"
                     pieces.append(
-                        f"~{num(span * metres)}: [ {self.p}Reveal({d}) ] t(0, 0, -({d})) {rule}"
+                        f"~{num(span * metres)}: [ {self.p}Reveal({d}) ] t(0, 0, {back}) {rule}"
                     )
                 else:
                     pieces.append(f"~{num(span * metres)}: {rule}")
             if not pieces:
                 pieces = ["~1: Plain"]
             lname = f"{name}L{level}"
-            self.lines.append(f"{lname}(kh, kw) --> split(x) {{ {' | '.join(pieces)} }}")
+            self.lines.append(_block_rule(f"{lname}(kh, kw) --> split(x)", pieces))
             span = (self.capture.floors[level + 1] - self.capture.floors[level]) * metres
             levels.append(f"~{num(span)}: {lname}(kh, kw)")
         height = (block.top - block.bottom) * metres
-        self.lines.append(
-            f"{name} --> {name}Levels(scope.sy / {num(height)}, scope.sx / {num(width * metres)})"
-        )
-        self.lines.append(f"{name}Levels(kh, kw) --> split(y) {{ {' | '.join(levels)} }}")
+        scales = f"scope.sy / {num(height)}, scope.sx / {num(width * metres)}"
+        self.lines.append(_Raw(f"{name} --> {name}Levels({scales})"))
+        self.lines.append(_block_rule(f"{name}Levels(kh, kw) --> split(y)", levels))
         return name
 
     def building(self) -> None:
@@ -314,14 +371,12 @@ class _Sheet:
                 f"{p}Block{k} --> t('{num(fx)}, 0, '{num(fz)}) "
                 f"s('{num(sx)}, '1, '{num(sz)}) {p}Block{k}Mass"
             )
-            self.lines.append(
-                f"{p}Block{k}Mass --> comp(f) {{ {' | '.join(walls)} | top: {p}Roof "
-                "| bottom: NIL }"
-            )
+            walls += [f"top: {p}Roof", "bottom: NIL"]
+            self.lines.append(_block_rule(f"{p}Block{k}Mass --> comp(f)", walls))
             parts.append(f"~{num((block.top - block.bottom) * cap.scale)}: {p}Block{k}")
             for what, size in zip(("width", "height", "depth"), block.size, strict=True):
-                self.consts.append(f"const {p}block{k}_{what} = {num(size * cap.scale)}")
-        self.lines.append(f"{p}Building --> split(y) {{ {' | '.join(parts)} }}")
+                self.consts.append(_Raw(f"const {p}block{k}_{what} = {num(size * cap.scale)}"))
+        self.lines.append(_block_rule(f"{p}Building --> split(y)", parts))
         self.lines.append(
             f"{p}Reveal(d) --> extrude(-d) comp(f) {{ side: reverseNormals() "
             'color("#8c8c8c") Plain | all: NIL }'
@@ -391,7 +446,7 @@ def style_text(sheets: list[tuple[Capture, Groups]], crops: Crops) -> str:
         out += split_rules(axis, m)
     for k, lines in enumerate(sections):
         capture = sheets[k][0]
-        out.append("")
+        out.append(_Raw(""))
         out.append(
             f"# ---- {comment_text(capture.building)}: {len(capture.blocks)} blocks, "
             f"{num(capture.scale, 2)} m high"
@@ -401,5 +456,4 @@ def style_text(sheets: list[tuple[Capture, Groups]], crops: Crops) -> str:
         )
         out += sheet_consts[k]
         out += lines
-    text = "\n".join(line for line in out if line is not None) + "\n"
-    return format_source(text, "<style sheet>")
+    return _render(out)
