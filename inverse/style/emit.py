@@ -14,7 +14,8 @@ of insertable pieces, the sizes and crops being parameters:
 
     SplitX2(a0, a1, a2, b0, b1, p, c1, c2, d0, d1, d2, s0, s1, s2, i0, i1) -->
         SplitX2Fit(.., floor(scope.sx / p))                 x whole patterns of length p
-    SplitX2Fit(.., x) --> case scope.sx - x * p >= c2: SplitX2Run(.., x, 2, Sr) | ..
+    SplitX2Fit(.., x) --> SplitX2Y(.., x, (scope.sx - x * p >= c1 ? 1 : 0) + (.. >= c2 ? 1 : 0))
+    SplitX2Y(.., x, y) --> case (a tie, y = 0): .. | else: SplitX2Run(a.., b.., s.., i.., x, y, Sr)
     SplitX2Run(.., x, y, sr) --> case x > 0: split(x) { a0 * sr: Wall(s0) | b0: Window(i0) | ..
                                                         | ~1: SplitX2Run(.., x - 1, y, sr) }
         | else: split(x) { ~a0: Wall(s0) | (y > 0 ? b0 : 0): Window(i0) | .. }   the tail
@@ -126,11 +127,14 @@ def split_rules(axis: str, m: int) -> list[str]:
     pieces: crops of windows along x (``Window(i)``), the window rows' rules along y.  A group's
     rule is then one line of its numbers, and a face's one line of its crops.
 
-    ``..Fit`` takes x = floor(W / P) whole patterns and the largest tail y whose insertable
-    pieces b0 .. b(y-1) fit what is left, Sr filling the scope (ties in the window count go to
-    the layout whose walls stretch least, as before); ``..Run`` lays the whole patterns one by
-    one, then the tail [a0 b0 .. a(y-1) b(y-1) ay] as one split whose pieces beyond y have size
-    0 (a split makes no shape of size 0), so the text grows with m, not m^2."""
+    ``..Fit`` takes x = floor(W / P) whole patterns; ``..Y`` the largest tail y whose insertable
+    pieces b0 .. b(y-1) fit what is left (the count of the sums c_k the rest holds: they grow
+    with k), Sr filling the scope, and a tie in the window count when no tail fits goes to the
+    layout whose walls stretch least; ``..Run`` lays the whole patterns one by one, then the
+    tail [a0 b0 .. a(y-1) b(y-1) ay] as one split whose pieces beyond y have size 0 (a split
+    makes no shape of size 0).  Every choice is one expression rather than a case per y, so the
+    text grows with m, not m^2 (the rules pass every parameter on: a case per y made a rule
+    of 74 windows 70,000 tokens long)."""
     a = [f"a{k}" for k in range(m + 1)]
     b = [f"b{k}" for k in range(m)]
     c = [f"c{k}" for k in range(1, m + 1)]  # c_y = b0 + .. + b(y-1)
@@ -140,19 +144,17 @@ def split_rules(axis: str, m: int) -> list[str]:
     scalable = [f"Wall({v})" for v in s]
     inserted = [f"Window({v})" for v in i] if axis == "x" else i
     name = f"Split{axis.upper()}{m}"
-    lead = ", ".join(a + b + ["p"] + c + d + s + i)
+    every = ", ".join(a + b + ["p"] + c + d + s + i)
+    pieces = ", ".join(a + b + s + i)  # what laying the pieces out needs
     size = f"scope.s{axis}"
     sum_a, sum_b = d[m], c[m - 1]
-    cases = []
-    for y in range(m, -1, -1):
-        fill = f"{size} - x * {sum_b} - {c[y - 1]}" if y else f"{size} - x * {sum_b}"
-        sr = f"({fill}) / (x * {sum_a} + {d[y]})"
-        if y == 0:  # a tie in the window count: the layout whose walls stretch least
-            alt = f"({size} - x * {sum_b}) / (x * {sum_a})"
-            fewer = f"{name}Run({lead}, x - 1, {m}, {alt})"
-            cases.append(f"case x > 0 and abs({alt} - 1) < abs({sr} - 1): {fewer}")
-        guard = f"case {size} - x * p >= {c[y - 1]}: " if y else "else: "
-        cases.append(f"{guard}{name}Run({lead}, x, {y}, {sr})")
+    # y: how many of c1 <= c2 <= .. <= cm the rest holds, i.e. the largest y with c_y <= rest
+    y = _balanced([f"({size} - x * p >= {v} ? 1 : 0)" for v in c])
+    tail_b = _balanced([f"(y == {k} ? {v} : 0)" for k, v in enumerate(c, 1)])
+    tail_a = _balanced([f"(y == {k} ? {v} : 0)" for k, v in enumerate(d)])
+    sr = f"({size} - x * {sum_b} - {tail_b}) / (x * {sum_a} + {tail_a})"
+    alt = f"({size} - x * {sum_b}) / (x * {sum_a})"
+    sr0 = f"({size} - x * {sum_b}) / (x * {sum_a} + {d[0]})"
     whole = [f"{a[0]} * sr: {scalable[0]}"]
     tail = [f"~{a[0]}: {scalable[0]}"]
     for k in range(m):
@@ -161,16 +163,27 @@ def split_rules(axis: str, m: int) -> list[str]:
             f"(y > {k} ? {b[k]} : 0): {inserted[k]}",
             f"~(y > {k} ? {a[k + 1]} : 0): {scalable[k + 1]}",
         ]
-    whole.append(f"~1: {name}Run({lead}, x - 1, y, sr)")
-    runs = [
-        f"case x > 0: split({axis}) {{ {' | '.join(whole)} }}",
-        f"else: split({axis}) {{ {' | '.join(tail)} }}",
-    ]
+    whole.append(f"~1: {name}Run({pieces}, x - 1, y, sr)")
+    fewer = f"{name}Run({pieces}, x - 1, {m}, {alt})"
     return [
-        f"{name}({lead}) --> {name}Fit({lead}, floor({size} / p))",
-        f"{name}Fit({lead}, x) --> " + " | ".join(cases),
-        f"{name}Run({lead}, x, y, sr) --> " + " | ".join(runs),
+        f"{name}({every}) --> {name}Fit({every}, floor({size} / p))",
+        f"{name}Fit({every}, x) --> {name}Y({every}, x, {y})",
+        # a tie in the window count (no tail fits): the layout whose walls stretch least
+        f"{name}Y({every}, x, y) --> "
+        f"case y == 0 and x > 0 and abs({alt} - 1) < abs({sr0} - 1): {fewer} "
+        f"| else: {name}Run({pieces}, x, y, {sr})",
+        f"{name}Run({pieces}, x, y, sr) --> "
+        f"case x > 0: split({axis}) {{ {' | '.join(whole)} }} "
+        f"| else: split({axis}) {{ {' | '.join(tail)} }}",
     ]
+
+
+def _balanced(terms: list[str]) -> str:
+    """A sum of terms nested log2(n) deep: the checker limits an expression's depth."""
+    if len(terms) == 1:
+        return terms[0]
+    half = len(terms) // 2
+    return f"({_balanced(terms[:half])} + {_balanced(terms[half:])})"
 
 
 def _params(params: tuple[str, ...]) -> str:
