@@ -7,15 +7,26 @@ into the source's blocks at their relative heights, sets each block back as the 
 front, right, back and left): the wall's levels at their relative heights, each level's faces at
 their relative widths, a face set back from the block's outer boundary recessed by its depth.
 
-Each face is cut along y by its level's vertical rule and each window row along x by its
-stack's horizontal rule, both **exactly as equations 8 and 9** (section 5.2.3), in the
-grammar's own terms so that any mass can take it:
+Each face is cut along y by its level group's vertical rule and each window row along x by its
+stack group's horizontal rule, both **exactly as equations 8 and 9** (section 5.2.3), in the
+grammar's own terms so that any mass can take it.  The equations are written once per number m
+of insertable pieces, the sizes and crops being parameters:
 
-    F --> FFit(floor(scope.sx / P))                 x: whole repeats of the pattern
-    FFit(x) --> case scope.sx - x * P >= b1 + b2: FRun(x, 2, Sr) | ... | else: FRun(x, 0, Sr)
-    FRun(x, y, sr) --> case x > 0: split(x) { a1 * sr: .. | b1: .. | .. | ~1: FRun(x - 1, y, sr) }
-                     | case y == 2: split(x) { ~a1: .. | b1: .. | ~a2: .. | b2: .. | ~a3: .. }
-                     | ...                          the tail [b1 .. by] with [a1 .. a(y+1)]
+    SplitX2(a0, a1, a2, b0, b1, p, c1, c2, d0, d1, d2, s0, s1, s2, i0, i1) -->
+        SplitX2Fit(.., floor(scope.sx / p))                 x whole patterns of length p
+    SplitX2Fit(.., x) --> SplitX2Y(.., x, (scope.sx - x * p >= c1 ? 1 : 0) + (.. >= c2 ? 1 : 0))
+    SplitX2Y(.., x, y) --> case (a tie, y = 0): .. | else: SplitX2Run(a.., b.., s.., i.., x, y, Sr)
+    SplitX2Run(.., x, y, sr) --> case x > 0: split(x) { a0 * sr: Wall(s0) | b0: Window(i0) | ..
+                                                        | ~1: SplitX2Run(.., x - 1, y, sr) }
+        | else: split(x) { ~a0: Wall(s0) | (y > 0 ? b0 : 0): Window(i0) | .. }   the tail
+
+(c_y and d_y the sums of b0 .. b(y-1) and a0 .. ay, see :func:`split_rules`).  A group's rule
+is one line of its numbers (``Bays3(s0, s1, i0) --> SplitX1(0.8, 0.8, 1.2, 2.8, 1.2, 0.8, 1.6,
+s0, s1, i0)``), and a face one line of its crops per window row (``F7Row0 --> Bays3("..", "..",
+"..")``; along y the window rows are rules handed to the group's rule).  So the text grows with
+the crops, not with faces x pieces x tail cases: PLATEAU's 10 buildings took 22,900 lines
+(parsing and formatting them was most of a capture's time) and take 4,300, deriving the same
+meshes (benchmarked in bench/style.py, docs/benchmarks.md).
 
 Sizes are metres: windows (insertable pieces) keep the size they had, walls (scalable pieces)
 stretch by Sr.  Every piece shows its crop of the face's own texture (``Window("...")`` or
@@ -27,15 +38,24 @@ from __future__ import annotations
 
 import hashlib
 import io
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
 
-from bgr.grammar.formatter import format_number, format_source, format_string
-from bgr.grammar.safe_text import comment_text
+from bgr.grammar.formatter import (
+    HEAD_WIDTH,
+    INDENT,
+    WIDTH,
+    format_number,
+    format_source,
+    format_string,
+)
+from bgr.grammar.safe_text import comment_line, comment_text
 
 from .groups import RIGHTWARD, Groups, along
 from .model import OUTWARD, WALLS, Block, Capture, Face
+from .rules import Rule
 
 MIN_PIECE = 0.001  # metres: a scalable piece this short still takes its share (no 0 / 0)
 RECESS = 0.02  # metres: a face set back less than this is flush with its wall
@@ -72,7 +92,7 @@ class Crops:
             size = (min(pil.width, self.max_size), min(pil.height, self.max_size))
             pil = pil.resize(size, Image.Resampling.BOX)
         out = io.BytesIO()
-        pil.save(out, "PNG", optimize=False)
+        pil.save(out, "PNG", compress_level=1)  # 5 % larger than zlib 6, half the time
         data = out.getvalue()
         key = hashlib.sha256(data).hexdigest()
         if key not in self._names:
@@ -91,61 +111,84 @@ def _pixels(cuts: list[tuple[str, float, float]], n: int) -> list[tuple[str, int
     return out
 
 
-def fit_rules(
-    name: str,
-    axis: str,
-    scalable: tuple[float, ...],
-    insertable: tuple[float, ...],
-    scalable_piece: list[str],
-    insertable_piece: list[str],
-    params: tuple[str, ...] = (),
-) -> list[str]:
-    """Rules realising split_h / split_v (equations 8-9) of a rule A (scalable), B (insertable)
-    along ``axis``: ``name(params)`` fills its scope with x whole patterns and the tail."""
+def split_sizes(scalable: Sequence[float], insertable: Sequence[float]) -> list[str]:
+    """The numbers a group hands its Split rule: A (a0 .. am, each at least MIN_PIECE), B (b0 ..
+    b(m-1)), the pattern's length P, the sums c1 .. cm of b0 .. b(y-1) and d0 .. dm of a0 ..
+    ay.  The sums are rounded here, once, like the sizes: summed by the grammar they would
+    carry float error, and a target exactly as wide as a sum (the source's own mass) would
+    fall on either side of an equation 8 comparison."""
     a = [max(MIN_PIECE, v) for v in scalable]
     b = list(insertable)
-    m = len(b)
+    sums = [sum(a) + sum(b)] + [sum(b[:y]) for y in range(1, len(b) + 1)]
+    sums += [sum(a[: y + 1]) for y in range(len(a))]
+    return [num(v) for v in a + b + sums]
+
+
+def split_rules(axis: str, m: int) -> list[str]:
+    """Equations 8-9 (split_h along x, split_v along y) once for every rule of ``m >= 1``
+    insertable pieces: ``SplitX<m>(a0 .. am, b0 .. b(m-1), p, c1 .. cm, d0 .. dm, s0 .. sm,
+    i0 .. i(m-1))`` takes the sizes of A (scalable, metres) and B (insertable) and their sums
+    (:func:`split_sizes`), the crops of the scalable pieces (``Wall(s)``) and the insertable
+    pieces: crops of windows along x (``Window(i)``), the window rows' rules along y.  A group's
+    rule is then one line of its numbers, and a face's one line of its crops.
+
+    ``..Fit`` takes x = floor(W / P) whole patterns; ``..Y`` the largest tail y whose insertable
+    pieces b0 .. b(y-1) fit what is left (the count of the sums c_k the rest holds: they grow
+    with k), Sr filling the scope, and a tie in the window count when no tail fits goes to the
+    layout whose walls stretch least; ``..Run`` lays the whole patterns one by one, then the
+    tail [a0 b0 .. a(y-1) b(y-1) ay] as one split whose pieces beyond y have size 0 (a split
+    makes no shape of size 0).  Every choice is one expression rather than a case per y, so the
+    text grows with m, not m^2 (the rules pass every parameter on: a case per y made a rule
+    of 74 windows 70,000 tokens long)."""
+    a = [f"a{k}" for k in range(m + 1)]
+    b = [f"b{k}" for k in range(m)]
+    c = [f"c{k}" for k in range(1, m + 1)]  # c_y = b0 + .. + b(y-1)
+    d = [f"d{k}" for k in range(m + 1)]  # d_y = a0 + .. + ay
+    s = [f"s{k}" for k in range(m + 1)]
+    i = [f"i{k}" for k in range(m)]
+    scalable = [f"Wall({v})" for v in s]
+    inserted = [f"Window({v})" for v in i] if axis == "x" else i
+    name = f"Split{axis.upper()}{m}"
+    every = ", ".join(a + b + ["p"] + c + d + s + i)
+    pieces = ", ".join(a + b + s + i)  # what laying the pieces out needs
     size = f"scope.s{axis}"
-    head = ", ".join(params)
-    lead = head + ", " if head else ""
-    if m == 0:  # no insertable element: one scalable piece stretched over the whole scope
-        return [f"{name}{_params(params)} --> {scalable_piece[0]}"]
-    pattern = num(sum(a) + sum(b))
-    cases = []
-    for y in range(m, -1, -1):
-        rest = f"{size} - x * {pattern}"
-        fill = f"{size} - x * {num(sum(b))} - {num(sum(b[:y]))}"
-        sr = f"({fill}) / (x * {num(sum(a))} + {num(sum(a[: y + 1]))})"
-        if y == 0:  # a tie in the window count: the layout whose walls stretch least
-            alt = f"({size} - x * {num(sum(b))}) / (x * {num(sum(a))})"
-            cases.append(
-                f"case x > 0 and abs({alt} - 1) < abs({sr} - 1): {name}Run({lead}x - 1, {m}, {alt})"
-            )
-        guard = f"case {rest} >= {num(sum(b[:y]))}: " if y else "else: "
-        cases.append(f"{guard}{name}Run({lead}x, {y}, {sr})")
-    whole = [f"{num(a[0])} * sr: {scalable_piece[0]}"]
-    for i in range(m):
-        whole += [
-            f"{num(b[i])}: {insertable_piece[i]}",
-            f"{num(a[i + 1])} * sr: {scalable_piece[i + 1]}",
+    sum_a, sum_b = d[m], c[m - 1]
+    # y: how many of c1 <= c2 <= .. <= cm the rest holds, i.e. the largest y with c_y <= rest
+    y = _balanced([f"({size} - x * p >= {v} ? 1 : 0)" for v in c])
+    tail_b = _balanced([f"(y == {k} ? {v} : 0)" for k, v in enumerate(c, 1)])
+    tail_a = _balanced([f"(y == {k} ? {v} : 0)" for k, v in enumerate(d)])
+    sr = f"({size} - x * {sum_b} - {tail_b}) / (x * {sum_a} + {tail_a})"
+    alt = f"({size} - x * {sum_b}) / (x * {sum_a})"
+    sr0 = f"({size} - x * {sum_b}) / (x * {sum_a} + {d[0]})"
+    whole = [f"{a[0]} * sr: {scalable[0]}"]
+    tail = [f"~{a[0]}: {scalable[0]}"]
+    for k in range(m):
+        whole += [f"{b[k]}: {inserted[k]}", f"{a[k + 1]} * sr: {scalable[k + 1]}"]
+        tail += [
+            f"(y > {k} ? {b[k]} : 0): {inserted[k]}",
+            f"~(y > {k} ? {a[k + 1]} : 0): {scalable[k + 1]}",
         ]
-    runs = [
-        f"case x > 0: split({axis}) {{ {' | '.join(whole)} | ~1: {name}Run({lead}x - 1, y, sr) }}"
-    ]
-    for y in range(m, -1, -1):
-        tail = [f"~{num(a[0])}: {scalable_piece[0]}"]
-        for i in range(y):
-            tail += [
-                f"{num(b[i])}: {insertable_piece[i]}",
-                f"~{num(a[i + 1])}: {scalable_piece[i + 1]}",
-            ]
-        guard = f"case y == {y}: " if y else "else: "
-        runs.append(f"{guard}split({axis}) {{ {' | '.join(tail)} }}")
+    whole.append(f"~1: {name}Run({pieces}, x - 1, y, sr)")
+    fewer = f"{name}Run({pieces}, x - 1, {m}, {alt})"
     return [
-        f"{name}{_params(params)} --> {name}Fit({lead}floor({size} / {pattern}))",
-        f"{name}Fit({lead}x) --> " + " | ".join(cases),
-        f"{name}Run({lead}x, y, sr) --> " + " | ".join(runs),
+        f"{name}({every}) --> {name}Fit({every}, floor({size} / p))",
+        f"{name}Fit({every}, x) --> {name}Y({every}, x, {y})",
+        # a tie in the window count (no tail fits): the layout whose walls stretch least
+        f"{name}Y({every}, x, y) --> "
+        f"case y == 0 and x > 0 and abs({alt} - 1) < abs({sr0} - 1): {fewer} "
+        f"| else: {name}Run({pieces}, x, y, {sr})",
+        f"{name}Run({pieces}, x, y, sr) --> "
+        f"case x > 0: split({axis}) {{ {' | '.join(whole)} }} "
+        f"| else: split({axis}) {{ {' | '.join(tail)} }}",
     ]
+
+
+def _balanced(terms: list[str]) -> str:
+    """A sum of terms nested log2(n) deep: the checker limits an expression's depth."""
+    if len(terms) == 1:
+        return terms[0]
+    half = len(terms) // 2
+    return f"({_balanced(terms[:half])} + {_balanced(terms[half:])})"
 
 
 def _params(params: tuple[str, ...]) -> str:
@@ -156,81 +199,140 @@ def _hex(color: tuple[int, int, int]) -> str:
     return "#" + "".join(f"{int(c):02x}" for c in color)
 
 
+class _Raw(str):
+    """A line already in the formatter's layout (bgr fmt): a declaration, a comment or a rule of
+    one successor whose head is within HEAD_WIDTH columns (the formatter keeps such a rule on
+    one line however long).  The style sheet's bulk -- the faces' crop lines -- is written so,
+    and only the other rules go through the parser and the formatter: parsing the bulk back
+    was most of a capture's time.  tests/test_style_emit.py checks that bgr fmt leaves the
+    whole sheet unchanged."""
+
+
+def _comment(text: str) -> _Raw:
+    return _Raw(comment_line(text))
+
+
+def _render(lines: list[str]) -> str:
+    """The sheet's text: runs of lines that are not _Raw formatted by format_source, the _Raw
+    ones as they are."""
+    out: list[str] = []
+    run: list[str] = []
+
+    def flush() -> None:
+        if run:
+            out.append(format_source("\n".join(run) + "\n", "<style sheet>").rstrip("\n"))
+            run.clear()
+
+    for line in lines:
+        if isinstance(line, _Raw):
+            flush()
+            out.append(line)
+        else:
+            run.append(line)
+    flush()
+    return "\n".join(out) + "\n"
+
+
+def _block_rule(head: str, entries: list[str]) -> _Raw:
+    """``head { e1 | e2 .. }`` in the formatter's layout: one line when it fits in its width,
+    else one entry a line, each after the first behind ``| ``.  ``head`` is a rule head of at
+    most HEAD_WIDTH columns and one operation that takes the block, the entries formatted."""
+    line = f"{head} {{ {' | '.join(entries)} }}"
+    if len(line) <= WIDTH:
+        return _Raw(line)
+    rows = [f"{head} {{", f"{INDENT}{entries[0]}"]
+    rows += [f"{INDENT}| {e}" for e in entries[1:]]
+    return _Raw("\n".join(rows + ["}"]))
+
+
 class _Sheet:
     """Writes one building's section; ``p`` prefixes its rule names."""
 
-    def __init__(self, capture: Capture, groups: Groups, crops: Crops, p: str) -> None:
+    def __init__(
+        self, capture: Capture, groups: Groups, crops: Crops, p: str, splits: set[tuple[str, int]]
+    ) -> None:
         self.capture, self.groups, self.crops, self.p = capture, groups, crops, p
         self.index = {id(f): i for i, f in enumerate(groups.faces)}
         self.lines: list[str] = []
         self.consts: list[str] = []  # the source blocks' sizes, which bgr restyle matches
+        self.shared: list[str] = []  # the groups' rules, each written once
+        self.written: set[str] = set()
+        self.splits = splits  # (axis, m) of every Split rule the groups call
         self.named: dict[int, str] = {}  # id(face) -> its rule, written once
 
+    def group_rule(self, name: str, axis: str, rule: Rule) -> str:
+        """One group's rule, written once for all its faces: ``name(s0 .., i0 ..) -->
+        Split<axis><m>(its sizes, s0 .., i0 ..)``, the crops (or, along y, the window rows'
+        rules) being the face's parameters.  Along x a group without windows is one wall."""
+        if name in self.written:
+            return name
+        self.written.add(name)
+        m = len(rule.insertable)
+        s = [f"s{k}" for k in range(m + 1)]
+        i = [f"i{k}" for k in range(m)]
+        if m == 0:
+            self.shared.append(_Raw(f"{name}(s0) --> Wall(s0)"))
+            return name
+        self.splits.add((axis, m))
+        args = ", ".join(split_sizes(rule.scalable, rule.insertable) + s + i)
+        head = f"{name}({', '.join(s + i)})"
+        line = f"{head} --> Split{axis.upper()}{m}({args})"
+        self.shared.append(_Raw(line) if len(head + " -->") <= HEAD_WIDTH else line)
+        return name
+
     def face(self, face: Face) -> str:
-        """Rules of one face (written on first use); returns its rule name."""
+        """Rules of one face (written on first use: a wall and a side of an L may both show
+        it); returns its rule name."""
         if id(face) not in self.named:
             self.named[id(face)] = self._face(face)
         return self.named[id(face)]
 
     def _face(self, face: Face) -> str:
+        """The face calls its level group's rows rule with its own crops, each window row
+        calling its stack group's bays rule with that row's crops: the face's text is its
+        crops, the splitting is its groups'."""
         i = self.index[id(face)]
         name = f"{self.p}F{i}"
         g = self.groups
-        rows, columns = g.rows[g.horizontal[i]], g.columns[g.vertical[i]]
+        h, v = g.horizontal[i], g.vertical[i]
+        rows, columns = g.rows[h], g.columns[v]
         metres = self.capture.scale
         self.lines.append(
-            f"# {WALLS[face.wall]} wall, level {face.level}: {num(face.width * metres, 2)} x "
-            f"{num(face.height * metres, 2)} m, {len(rows.insertable)} window rows of "
-            f"{len(columns.insertable)} bays (rows: group {g.horizontal[i]}, bays: group "
-            f"{g.vertical[i]})"
+            _comment(
+                f"# {WALLS[face.wall]} wall, level {face.level}: {num(face.width * metres, 2)} x "
+                f"{num(face.height * metres, 2)} m, {len(rows.insertable)} window rows of "
+                f"{len(columns.insertable)} bays (rows: group {h}, bays: group {v})"
+            )
         )
         texture = face.texture
         if texture is None:
-            self.lines.append(f'{name} --> color("{_hex(face.color)}") Plain')
+            self.lines.append(_Raw(f'{name} --> color("{_hex(face.color)}") Plain'))
             return name
-        h, w = texture.shape[:2]
-        row_px = _pixels(g.row_cuts[g.horizontal[i]], h)[::-1]  # bottom to top, as C and D
-        col_px = _pixels(g.column_cuts[g.vertical[i]], w)
+        th, tw = texture.shape[:2]
+        row_px = _pixels(g.row_cuts[h], th)[::-1]  # bottom to top, as C and D
+        col_px = _pixels(g.column_cuts[v], tw)
         if not rows.insertable:  # no window row: the bays run the face's full height
-            row_px = [("insertable", 0, h)]
+            row_px = [("insertable", 0, th)]
         bands = [(r0, r1) for kind, r0, r1 in row_px if kind == "scalable"]
         lines = [(r0, r1) for kind, r0, r1 in row_px if kind == "insertable"]
+        walls = [(c0, c1) for kind, c0, c1 in col_px if kind == "scalable"]
+        bays = [(c0, c1) for kind, c0, c1 in col_px if kind == "insertable"]
 
         def crop(r: tuple[int, int], c: tuple[int, int]) -> str:
             return format_string(self.crops.add(texture[r[0] : r[1], c[0] : c[1]]))
 
-        walls = [(c0, c1) for kind, c0, c1 in col_px if kind == "scalable"]
-        bays = [(c0, c1) for kind, c0, c1 in col_px if kind == "insertable"]
-        cols = f"{name}Bays"
-        many = len(lines) > 1
-
-        def piece(kind: str, c: tuple[int, int], k: int) -> str:
-            if many:
-                return f"{cols}{kind}{k}(row)"
-            return f"{kind}({crop(lines[0], c)})"
-
-        if rows.insertable:
-            row_pieces = [f"Wall({crop(r, (0, w))})" for r in bands]
-            line_pieces = [f"{cols}({j})" if many else cols for j in range(len(lines))]
-            self.lines += fit_rules(
-                name, "y", rows.scalable, rows.insertable, row_pieces, line_pieces
-            )
-        else:
-            self.lines.append(f"{name} --> {cols}")
-        params = ("row",) if many else ()
-        wall_pieces = [piece("Wall", c, k) for k, c in enumerate(walls)]
-        bay_pieces = [piece("Window", c, k) for k, c in enumerate(bays)]
-        self.lines += fit_rules(
-            cols, "x", columns.scalable, columns.insertable, wall_pieces, bay_pieces, params
-        )
-        if many:  # one rule per piece of the pattern, choosing its crop by window row
-            for kind, spans in (("Wall", walls), ("Window", bays)):
-                for k, c in enumerate(spans):
-                    options = [
-                        f"case row == {j}: {kind}({crop(r, c)})" for j, r in enumerate(lines[:-1])
-                    ]
-                    options.append(f"else: {kind}({crop(lines[-1], c)})")
-                    self.lines.append(f"{cols}{kind}{k}(row) --> " + " | ".join(options))
+        bays_rule = self.group_rule(f"{self.p}Bays{v}", "x", columns)
+        calls = [
+            f"{bays_rule}({', '.join([crop(r, c) for c in walls] + [crop(r, c) for c in bays])})"
+            for r in lines
+        ]
+        if not rows.insertable:
+            self.lines.append(_Raw(f"{name} --> {calls[0]}"))
+            return name
+        args = [crop(r, (0, tw)) for r in bands] + [f"{name}Row{j}" for j in range(len(lines))]
+        rows_rule = self.group_rule(f"{self.p}Rows{h}", "y", rows)
+        self.lines.append(_Raw(f"{name} --> {rows_rule}({', '.join(args)})"))
+        self.lines += [_Raw(f"{name}Row{j} --> {call}") for j, call in enumerate(calls)]
         return name
 
     def wall(self, b: int, block: Block, w: int, below_gap: float | None) -> str:
@@ -254,22 +356,22 @@ class _Sheet:
                     d = f"{num(depth)} * kh"
                     if below_gap is not None and depth < below_gap:  # the overhang fix (5.1.2)
                         d = f"min({d}, 0.9 * {num(below_gap)} * kw)"
+                    back = f"-{d}" if d.startswith("min(") else f"-({d})"
                     pieces.append(
-                        f"~{num(span * metres)}: [ {self.p}Reveal({d}) ] t(0, 0, -({d})) {rule}"
+                        f"~{num(span * metres)}: [ {self.p}Reveal({d}) ] t(0, 0, {back}) {rule}"
                     )
                 else:
                     pieces.append(f"~{num(span * metres)}: {rule}")
             if not pieces:
                 pieces = ["~1: Plain"]
             lname = f"{name}L{level}"
-            self.lines.append(f"{lname}(kh, kw) --> split(x) {{ {' | '.join(pieces)} }}")
+            self.lines.append(_block_rule(f"{lname}(kh, kw) --> split(x)", pieces))
             span = (self.capture.floors[level + 1] - self.capture.floors[level]) * metres
             levels.append(f"~{num(span)}: {lname}(kh, kw)")
         height = (block.top - block.bottom) * metres
-        self.lines.append(
-            f"{name} --> {name}Levels(scope.sy / {num(height)}, scope.sx / {num(width * metres)})"
-        )
-        self.lines.append(f"{name}Levels(kh, kw) --> split(y) {{ {' | '.join(levels)} }}")
+        scales = f"scope.sy / {num(height)}, scope.sx / {num(width * metres)}"
+        self.lines.append(_Raw(f"{name} --> {name}Levels({scales})"))
+        self.lines.append(_block_rule(f"{name}Levels(kh, kw) --> split(y)", levels))
         return name
 
     def side(self, b: int, block: Block, w: int, full_rule: str) -> str:
@@ -299,7 +401,7 @@ class _Sheet:
             for level, face in zip(block.levels, columns[j][1], strict=True):
                 span = (self.capture.floors[level + 1] - self.capture.floors[level]) * metres
                 pieces.append(f"~{num(span)}: {self.face(face) if face is not None else 'Plain'}")
-            self.lines.append(f"{part} --> split(y) {{ {' | '.join(pieces)} }}")
+            self.lines.append(_block_rule(f"{part} --> split(y)", pieces))
             if n_ + 1 < len(order):
                 limit = (shares[j] + shares[order[n_ + 1]]) / 2.0
                 cases.append(f"case scope.sx < {num(limit)} * full: {part}")
@@ -331,16 +433,16 @@ class _Sheet:
                 f"{p}Block{k} --> t('{num(fx)}, 0, '{num(fz)}) "
                 f"s('{num(sx)}, '1, '{num(sz)}) {p}Block{k}Mass"
             )
-            faces = f"comp(f) {{ {' | '.join(walls)} | top: {p}Roof | bottom: NIL }}"
-            if "(bw)" in faces or "(bd)" in faces:  # the sides' full widths for ``side``
-                self.lines.append(f"{p}Block{k}Mass --> {p}Block{k}Faces(scope.sx, scope.sz)")
-                self.lines.append(f"{p}Block{k}Faces(bw, bd) --> {faces}")
+            walls += [f"top: {p}Roof", "bottom: NIL"]
+            if any("(bw)" in w or "(bd)" in w for w in walls):  # the sides' widths for ``side``
+                self.lines.append(_Raw(f"{p}Block{k}Mass --> {p}Block{k}Faces(scope.sx, scope.sz)"))
+                self.lines.append(_block_rule(f"{p}Block{k}Faces(bw, bd) --> comp(f)", walls))
             else:
-                self.lines.append(f"{p}Block{k}Mass --> {faces}")
+                self.lines.append(_block_rule(f"{p}Block{k}Mass --> comp(f)", walls))
             parts.append(f"~{num((block.top - block.bottom) * cap.scale)}: {p}Block{k}")
             for what, size in zip(("width", "height", "depth"), block.size, strict=True):
-                self.consts.append(f"const {p}block{k}_{what} = {num(size * cap.scale)}")
-        self.lines.append(f"{p}Building --> split(y) {{ {' | '.join(parts)} }}")
+                self.consts.append(_Raw(f"const {p}block{k}_{what} = {num(size * cap.scale)}"))
+        self.lines.append(_block_rule(f"{p}Building --> split(y)", parts))
         self.lines.append(
             f"{p}Reveal(d) --> extrude(-d) comp(f) {{ side: reverseNormals() "
             'color("#8c8c8c") Plain | all: NIL }'
@@ -395,10 +497,11 @@ def style_text(sheets: list[tuple[Capture, Groups]], crops: Crops) -> str:
     out = [HEADER, "version 1", ""]
     sections: list[list[str]] = []
     sheet_consts: list[list[str]] = []
+    splits: set[tuple[str, int]] = set()
     for k, (capture, groups) in enumerate(sheets):
-        sheet = _Sheet(capture, groups, crops, f"S{k}" if len(sheets) > 1 else "")
+        sheet = _Sheet(capture, groups, crops, f"S{k}" if len(sheets) > 1 else "", splits)
         sheet.building()
-        sections.append(sheet.lines)
+        sections.append(sheet.shared + sheet.lines)
         sheet_consts.append(sheet.consts)
     first = sheets[0][0]
     if len(sheets) > 1:
@@ -441,9 +544,14 @@ def style_text(sheets: list[tuple[Capture, Groups]], crops: Crops) -> str:
         "Window(file) --> color(\"#ffffff\") setupProjection(0, scope.xy, '1, '1) projectUV(0) "
         "texture(file) WindowTile"
     )
+    out.append(
+        "# equations 8 and 9: a group's sizes, then its pieces' crops (along y: its window rows)"
+    )
+    for axis, m in sorted(splits):
+        out += split_rules(axis, m)
     for k, lines in enumerate(sections):
         capture = sheets[k][0]
-        out.append("")
+        out.append(_Raw(""))
         out.append(
             f"# ---- {comment_text(capture.building)}: {len(capture.blocks)} blocks, "
             f"{num(capture.scale, 2)} m high"
@@ -453,5 +561,4 @@ def style_text(sheets: list[tuple[Capture, Groups]], crops: Crops) -> str:
         )
         out += sheet_consts[k]
         out += lines
-    text = "\n".join(line for line in out if line is not None) + "\n"
-    return format_source(text, "<style sheet>")
+    return _render(out)

@@ -17,6 +17,7 @@ from collections.abc import Iterable
 import numpy as np
 
 from bgr.grammar import nodes as n
+from bgr.grammar.checker import Grammar
 from bgr.grammar.errors import BgrError, Diagnostic
 
 
@@ -106,12 +107,13 @@ def _front_first(ring: np.ndarray) -> np.ndarray:
 
 def restyle(
     mass: str,
-    style: str,
+    style: str | Grammar,
     seed: int = 0,
     section: int = 0,
     allow_paths: Iterable[str | os.PathLike] = (),
 ):
-    """The styled mass (a bgr.interpreter.derive.Result) and a one-line report."""
+    """The styled mass (a bgr.interpreter.derive.Result) and a one-line report.  ``style`` is the
+    sheet's path, or the sheet loaded once (bgr.load) to style several masses with it."""
     from bgr.grammar.loader import load
     from bgr.interpreter.derive import derive
     from bgr.interpreter.lots import footprint
@@ -119,7 +121,7 @@ def restyle(
     from .capture import read_model
     from .remesh import capture_geometry
 
-    grammar = load(style, allow_paths=allow_paths)
+    grammar = style if isinstance(style, Grammar) else load(style, allow_paths=allow_paths)
     several = "S0block0_width" in grammar.consts
     if (
         section
