@@ -6,6 +6,13 @@ into the source's blocks at their relative heights, sets each block back as the 
 (``t`` and ``s`` in fractions of the lot), and decorates each of its four walls (comp(f)'s
 front, right, back and left): the wall's levels at their relative heights, each level's faces at
 their relative widths, a face set back from the block's outer boundary recessed by its depth.
+A recess keeps its depth in metres, as a window keeps its size, but shrinks with the block's
+extent across the wall (``k``: the target block's depth behind the wall over the source's, at
+most 1; times ``recess_x`` / ``recess_z``, which bgr restyle lowers on a mass that is not a box
+to its thinnest part over its extent), and reaches at most DEEPEST of the block: so a reveal
+stays inside any target.  Scaled by the wall's height or width instead, a 1 m recess of a 7 m
+block became 8.5 m on a 60 m slab and its reveal ran through the building and out of the
+opposite wall.
 
 Each face is cut along y by its level's vertical rule and each window row along x by its
 stack's horizontal rule, both **exactly as equations 8 and 9** (section 5.2.3), in the
@@ -39,6 +46,7 @@ from .model import OUTWARD, WALLS, Block, Capture, Face
 
 MIN_PIECE = 0.001  # metres: a scalable piece this short still takes its share (no 0 / 0)
 RECESS = 0.02  # metres: a face set back less than this is flush with its wall
+DEEPEST = 0.9  # a recess is at most this fraction of the block's extent behind its wall
 
 
 def num(x: float, digits: int = 4) -> str:
@@ -182,8 +190,6 @@ class _Sheet:
         col_px = _pixels(g.column_cuts[g.vertical[i]], w)
         if not rows.insertable:  # no window row: the bays run the face's full height
             row_px = [("insertable", 0, h)]
-        bands = [(r0, r1) for kind, r0, r1 in row_px if kind == "scalable"]
-        lines = [(r0, r1) for kind, r0, r1 in row_px if kind == "insertable"]
 
         def crop(r: tuple[int, int], c: tuple[int, int]) -> str:
             return format_string(self.crops.add(texture[r[0] : r[1], c[0] : c[1]]))
@@ -191,16 +197,20 @@ class _Sheet:
         walls = [(c0, c1) for kind, c0, c1 in col_px if kind == "scalable"]
         bays = [(c0, c1) for kind, c0, c1 in col_px if kind == "insertable"]
         cols = f"{name}Bays"
-        many = len(lines) > 1
+        many = len(row_px) > 1
 
         def piece(kind: str, c: tuple[int, int], k: int) -> str:
             if many:
                 return f"{cols}{kind}{k}(row)"
-            return f"{kind}({crop(lines[0], c)})"
+            return f"{kind}({crop(row_px[0][1:], c)})"
 
         if rows.insertable:
-            row_pieces = [f"Wall({crop(r, (0, w))})" for r in bands]
-            line_pieces = [f"{cols}({j})" if many else cols for j in range(len(lines))]
+            # Every row, window row or wall band, is cut by the stack's columns: a band cropped
+            # whole and stretched over a wider face smeared (a 29-pixel band of a 7 m face
+            # over a 30 m slab is 1 pixel a metre); cut at the window columns, it repeats
+            # with them at the density it was photographed at.
+            row_pieces = [f"{cols}({j})" for j, r in enumerate(row_px) if r[0] == "scalable"]
+            line_pieces = [f"{cols}({j})" for j, r in enumerate(row_px) if r[0] == "insertable"]
             self.lines += fit_rules(
                 name, "y", rows.scalable, rows.insertable, row_pieces, line_pieces
             )
@@ -212,14 +222,17 @@ class _Sheet:
         self.lines += fit_rules(
             cols, "x", columns.scalable, columns.insertable, wall_pieces, bay_pieces, params
         )
-        if many:  # one rule per piece of the pattern, choosing its crop by window row
+        if many:  # one rule per piece of the pattern, choosing its crop by row
             for kind, spans in (("Wall", walls), ("Window", bays)):
                 for k, c in enumerate(spans):
-                    options = [
-                        f"case row == {j}: {kind}({crop(r, c)})" for j, r in enumerate(lines[:-1])
+                    options = [  # a wall band's pieces are all wall
+                        f"{kind if what == 'insertable' else 'Wall'}({crop((r0, r1), c)})"
+                        for what, r0, r1 in row_px
                     ]
-                    options.append(f"else: {kind}({crop(lines[-1], c)})")
-                    self.lines.append(f"{cols}{kind}{k}(row) --> " + " | ".join(options))
+                    cases = [f"case row == {j}: {o}" for j, o in enumerate(options[:-1])]
+                    self.lines.append(
+                        f"{cols}{kind}{k}(row) --> " + " | ".join([*cases, f"else: {options[-1]}"])
+                    )
         return name
 
     def wall(self, b: int, block: Block, w: int, below_gap: float | None) -> str:
@@ -229,37 +242,68 @@ class _Sheet:
         metres = self.capture.scale
         xmin, xmax, zmin, zmax = block.box
         outer = (-zmin, xmax, zmax, -xmin)[w]  # the outer boundary along OUTWARD[w]
-        width = (xmax - xmin) if w in (0, 2) else (zmax - zmin)
+        behind = ((zmax - zmin) if w in (0, 2) else (xmax - xmin)) * metres
         levels = []
-        for level in block.levels:
+        for at, level in enumerate(block.levels):
             on = [f for f in faces if f.level == level and along(f)[1] - along(f)[0] > 1e-9]
             on.sort(key=lambda f: along(f)[0])
             pieces = []
-            for f in on:
+            for j, f in enumerate(on):
                 span = along(f)[1] - along(f)[0]
-                depth = (outer - float(f.start @ OUTWARD[w])) * metres
+                # a level wider than the box that starts its block can put a face beyond
+                # the opposite wall: no recess reaches past DEEPEST of the block
+                depth = min((outer - float(f.start @ OUTWARD[w])) * metres, DEEPEST * behind)
                 rule = self.face(f)
                 if depth > RECESS:
-                    d = f"{num(depth)} * kh"
+                    d = f"{num(depth)} * min(1, k)"
                     if below_gap is not None and depth < below_gap:  # the overhang fix (5.1.2)
-                        d = f"min({d}, 0.9 * {num(below_gap)} * kw)"
+                        d = f"min({d}, 0.9 * {num(below_gap)} * k)"
+                    # a reveal's side at the wall's end would lie in the next wall's plane,
+                    # and its ceiling (floor) at the block's top (bottom) in the roof's (the
+                    # ground's or the block below's): those close the notch themselves, and
+                    # two coplanar faces flicker in any renderer that draws both sides
+                    ends = (
+                        f"{int(j > 0)}, {int(j < len(on) - 1)}, "
+                        f"{int(at < len(block.levels) - 1)}, {int(at > 0)}, "
+                        f'"{_hex(f.color)}"'
+                    )
                     pieces.append(
-                        f"~{num(span * metres)}: [ {self.p}Reveal({d}) ] t(0, 0, -({d})) {rule}"
+                        f"~{num(span * metres)}: [ {self.p}Reveal({d}, {ends}) ] "
+                        f"t(0, 0, -({d})) {rule}"
                     )
                 else:
                     pieces.append(f"~{num(span * metres)}: {rule}")
             if not pieces:
                 pieces = ["~1: Plain"]
             lname = f"{name}L{level}"
-            self.lines.append(f"{lname}(kh, kw) --> split(x) {{ {' | '.join(pieces)} }}")
+            self.lines.append(f"{lname}(k) --> split(x) {{ {' | '.join(pieces)} }}")
             span = (self.capture.floors[level + 1] - self.capture.floors[level]) * metres
-            levels.append(f"~{num(span)}: {lname}(kh, kw)")
-        height = (block.top - block.bottom) * metres
-        self.lines.append(
-            f"{name} --> {name}Levels(scope.sy / {num(height)}, scope.sx / {num(width * metres)})"
-        )
-        self.lines.append(f"{name}Levels(kh, kw) --> split(y) {{ {' | '.join(levels)} }}")
+            levels.append(f"~{num(span)}: {lname}(k)")
+        self.lines.append(f"{name}(k) --> split(y) {{ {' | '.join(levels)} }}")
         return name
+
+    def stack(self) -> str:
+        """The body of ``Stack``: every source block on one target block, without setbacks (bgr
+        restyle gives it to a mass of one block; see restyle.py).  The bottom block keeps its
+        height in metres, and so does the top one when there are three or more; the blocks
+        between them stretch to fill the rest, or, with two blocks, the top one does (the
+        storeys a taller building repeats are its middle ones).  A target lower than the
+        kept heights takes every block at its relative height instead."""
+        cap, p = self.capture, self.p
+        heights = [(b.top - b.bottom) * cap.scale for b in cap.blocks]
+        n = len(heights)
+        if n == 1:
+            return f"{p}Block0Mass"
+        kept = [0, n - 1] if n > 2 else [0]
+        fixed = sum(heights[j] for j in kept)
+        absolute = " | ".join(
+            f"{'' if j in kept else '~'}{num(h)}: {p}Block{j}Mass" for j, h in enumerate(heights)
+        )
+        relative = " | ".join(f"~{num(h)}: {p}Block{j}Mass" for j, h in enumerate(heights))
+        return (
+            f"case scope.sy > {num(fixed)}: split(y) {{ {absolute} }} "
+            f"| else: split(y) {{ {relative} }}"
+        )
 
     def building(self) -> None:
         cap, p = self.capture, self.p
@@ -276,7 +320,8 @@ class _Sheet:
                     mine = (-block.box[2], block.box[1], block.box[3], -block.box[0])[w]
                     theirs = (-above.box[2], above.box[1], above.box[3], -above.box[0])[w]
                     gap = (mine - theirs) * cap.scale if mine > theirs else None
-                walls.append(f"{WALLS[w]}: {self.wall(k, block, w, gap)}")
+                across = "kz" if w in (0, 2) else "kx"  # front and back recess along z
+                walls.append(f"{WALLS[w]}: {self.wall(k, block, w, gap)}({across})")
             xmin, xmax, zmin, zmax = block.box
             fx, fz = (xmin - x0) / (x1 - x0), (zmin - z0) / (z1 - z0)
             sx, sz = (xmax - xmin) / (x1 - x0), (zmax - zmin) / (z1 - z0)
@@ -284,17 +329,28 @@ class _Sheet:
                 f"{p}Block{k} --> t('{num(fx)}, 0, '{num(fz)}) "
                 f"s('{num(sx)}, '1, '{num(sz)}) {p}Block{k}Mass"
             )
+            width, _, depth = block.size
+            self.lines.append(  # k of the walls: the block's stretch across them
+                f"{p}Block{k}Mass --> {p}Block{k}Walls(scope.sx / {num(width * cap.scale)} "
+                f"* recess_x, scope.sz / {num(depth * cap.scale)} * recess_z)"
+            )
             self.lines.append(
-                f"{p}Block{k}Mass --> comp(f) {{ {' | '.join(walls)} | top: {p}Roof "
+                f"{p}Block{k}Walls(kx, kz) --> comp(f) {{ {' | '.join(walls)} | top: {p}Roof "
                 "| bottom: NIL }"
             )
             parts.append(f"~{num((block.top - block.bottom) * cap.scale)}: {p}Block{k}")
             for what, size in zip(("width", "height", "depth"), block.size, strict=True):
                 self.consts.append(f"const {p}block{k}_{what} = {num(size * cap.scale)}")
         self.lines.append(f"{p}Building --> split(y) {{ {' | '.join(parts)} }}")
+        self.lines.append(f"{p}Stack --> {self.stack()}")
         self.lines.append(
-            f"{p}Reveal(d) --> extrude(-d) comp(f) {{ side: reverseNormals() "
-            'color("#8c8c8c") Plain | all: NIL }'
+            f"{p}Reveal(d, l, r, t, b, c) --> extrude(-d) comp(f) {{ left: {p}RevealSide(l, c) "
+            f"| right: {p}RevealSide(r, c) | front: {p}RevealSide(t, c) "
+            f"| back: {p}RevealSide(b, c) | all: NIL }}"
+        )
+        self.lines.append(  # in the recessed face's mean colour, which its sides continue
+            f"{p}RevealSide(keep, c) --> case keep == 1: reverseNormals() color(c) Plain "
+            "| else: NIL"
         )
         self.lines.append(f'{p}Roof --> color("#9a9a9a") Plain')
 
@@ -323,11 +379,17 @@ def style_text(sheets: list[tuple[Capture, Groups]], crops: Crops) -> str:
         out.append("attr style = 0")
     out.append(f"attr height = {num(first.scale, 2)}  # metres; the source's height")
     out.append(
-        "# bgr restyle: the source block a target block takes (-1: the whole building on the lot)"
+        "# bgr restyle: the source block a target block takes (-1: the whole building on the "
+        "lot, -2: all its blocks stacked on the target block)"
     )
     out.append("attr block = -1")
     out.append("attr block_base = 0")
     out.append("attr block_height = 1")
+    out.append(
+        "# bgr restyle: the thinnest part of a target block that is not a box, over its extent"
+    )
+    out.append("attr recess_x = 1")
+    out.append("attr recess_z = 1")
     out.append("")
     out.append("terminal WallTile, WindowTile, Plain")
     starts = []
@@ -337,6 +399,7 @@ def style_text(sheets: list[tuple[Capture, Groups]], crops: Crops) -> str:
             f"case block == {j}: t(0, block_base, 0) extrude(block_height) {p}Block{j}Mass"
             for j in range(len(capture.blocks))
         ]
+        blocks.append(f"case block == -2: t(0, block_base, 0) extrude(block_height) {p}Stack")
         starts.append((p, " | ".join(blocks) + f" | else: extrude(height) {p}Building"))
     if len(starts) == 1:
         out.append(f"Lot --> {starts[0][1]}")
