@@ -247,32 +247,40 @@ class _Sheet:
         for at, level in enumerate(block.levels):
             on = [f for f in faces if f.level == level and along(f)[1] - along(f)[0] > 1e-9]
             on.sort(key=lambda f: along(f)[0])
-            pieces = []
-            for j, f in enumerate(on):
-                span = along(f)[1] - along(f)[0]
+            depths = []  # each face's recess: (metres at the source, its .bgr expression)
+            for f in on:
                 # a level wider than the box that starts its block can put a face beyond
                 # the opposite wall: no recess reaches past DEEPEST of the block
                 depth = min((outer - float(f.start @ OUTWARD[w])) * metres, DEEPEST * behind)
+                d = f"{num(depth)} * min(1, k)"
+                if below_gap is not None and depth < below_gap:  # the overhang fix (5.1.2)
+                    d = f"min({d}, 0.9 * {num(below_gap)} * k)"
+                depths.append((depth, d) if depth > RECESS else (0.0, "0"))
+            pieces = []
+            for j, f in enumerate(on):
+                span = along(f)[1] - along(f)[0]
                 rule = self.face(f)
-                if depth > RECESS:
-                    d = f"{num(depth)} * min(1, k)"
-                    if below_gap is not None and depth < below_gap:  # the overhang fix (5.1.2)
-                        d = f"min({d}, 0.9 * {num(below_gap)} * k)"
-                    # a reveal's side at the wall's end would lie in the next wall's plane,
-                    # and its ceiling (floor) at the block's top (bottom) in the roof's (the
-                    # ground's or the block below's): those close the notch themselves, and
-                    # two coplanar faces flicker in any renderer that draws both sides
-                    ends = (
-                        f"{int(j > 0)}, {int(j < len(on) - 1)}, "
-                        f"{int(at < len(block.levels) - 1)}, {int(at > 0)}, "
-                        f'"{_hex(f.color)}"'
-                    )
-                    pieces.append(
-                        f"~{num(span * metres)}: [ {self.p}Reveal({d}, {ends}) ] "
-                        f"t(0, 0, -({d})) {rule}"
-                    )
-                else:
+                depth, d = depths[j]
+                if not depth:
                     pieces.append(f"~{num(span * metres)}: {rule}")
+                    continue
+                # The notch's ceiling (floor) at the block's top (bottom) would lie in the roof
+                # (the block below's roof), which closes it, and two coplanar faces flicker in
+                # any renderer that draws both sides; on the ground the floor stays (a block
+                # has no bottom face: a view from above saw through the notch).  Its sides
+                # (jambs) run from the neighbour face's depth to its own, and only where the
+                # neighbour is shallower: at the wall's end the next wall closes it, and the
+                # deeper of two neighbours alone has the wall between them.
+                colour = f'"{_hex(f.color)}"'
+                top, bottom = int(at < len(block.levels) - 1), int(at > 0 or b == 0)
+                parts = [f"[ {self.p}Reveal({d}, {top}, {bottom}, {colour}) ]"]
+                for side, n in (("L", j - 1), ("R", j + 1)):
+                    if 0 <= n < len(on) and depths[n][0] < depth - RECESS:
+                        near = depths[n][1]
+                        parts.append(
+                            f"[ t(0, 0, -({near})) {self.p}Jamb{side}(({d}) - ({near}), {colour}) ]"
+                        )
+                pieces.append(f"~{num(span * metres)}: {' '.join(parts)} t(0, 0, -({d})) {rule}")
             if not pieces:
                 pieces = ["~1: Plain"]
             lname = f"{name}L{level}"
@@ -344,10 +352,14 @@ class _Sheet:
         self.lines.append(f"{p}Building --> split(y) {{ {' | '.join(parts)} }}")
         self.lines.append(f"{p}Stack --> {self.stack()}")
         self.lines.append(
-            f"{p}Reveal(d, l, r, t, b, c) --> extrude(-d) comp(f) {{ left: {p}RevealSide(l, c) "
-            f"| right: {p}RevealSide(r, c) | front: {p}RevealSide(t, c) "
+            f"{p}Reveal(d, t, b, c) --> extrude(-d) comp(f) {{ front: {p}RevealSide(t, c) "
             f"| back: {p}RevealSide(b, c) | all: NIL }}"
         )
+        for side, which in (("L", "left"), ("R", "right")):
+            self.lines.append(
+                f"{p}Jamb{side}(d, c) --> extrude(-max(d, 0)) comp(f) {{ {which}: "
+                f"{p}RevealSide(1, c) | all: NIL }}"
+            )
         self.lines.append(  # in the recessed face's mean colour, which its sides continue
             f"{p}RevealSide(keep, c) --> case keep == 1: reverseNormals() color(c) Plain "
             "| else: NIL"
