@@ -150,3 +150,49 @@ def test_thinnest_part_of_a_footprint() -> None:
     ell = np.array([(0, 0), (24, 0), (24, 8), (9.6, 8), (9.6, 16), (0, 16)], float)
     assert thinnest(ell) == pytest.approx((0.4, 0.5))
     assert thinnest(ell[::-1]) == pytest.approx((0.4, 0.5))  # either orientation
+
+
+def fitted(scalable: tuple, insertable: tuple, width: float) -> list[tuple[str, float]]:
+    """(terminal, width) of the pieces fit_rules' grammar cuts a lot ``width`` wide into."""
+    import io
+    import json
+
+    import bgr
+    from bgr.formats import write_json
+    from bgr.inverse.style.emit import fit_rules
+
+    walls = [f"W{i}" for i in range(len(scalable))]
+    windows = [f"B{i}" for i in range(len(insertable))]
+    rules = fit_rules("F", "x", scalable, insertable, walls, windows)
+    src = "\n".join(["version 1", f"terminal {', '.join(walls + windows)}", "Lot --> F", *rules])
+    result = bgr.derive(bgr.load(src + "\n"), lot=(width, 5.0))
+    buffer = io.StringIO()
+    write_json(result.terminals, buffer, seed=result.seed, attrs=result.attrs)
+    out = json.loads(buffer.getvalue())["terminals"]
+    return [(t["label"], round(t["size"][0], 4)) for t in out if t["size"][0] > 1e-9]
+
+
+@pytest.mark.parametrize(
+    ("width", "expected"),
+    [
+        # the source's own width: equations 8-9 as printed, Sr = 1
+        (13, [("W0", 0.5), ("B0", 12), ("W1", 0.5)]),
+        # Sr = (24 - 12) / (0.5 + 0.5 + 0.5) = 8 > MAX_SR: two patterns, each piece x 24 / 26
+        (24, [("W0", 0.4615), ("B0", 11.0769), ("W1", 0.4615)] * 2),
+        # x = 0, y = 0 (12 m does not fit in 5): one pattern x 5 / 13, not a1 over 5 m
+        (5, [("W0", 0.1923), ("B0", 4.6154), ("W1", 0.1923)]),
+        # x = 2, y = 0, Sr = (29 - 2 x 12) / (2 x 1 + 0.5) = 2, not above MAX_SR: equation 9
+        (29, [("W0", 1), ("B0", 12), ("W1", 1)] * 2 + [("W0", 1)]),
+    ],
+)
+def test_a_face_far_from_whole_patterns_scales_the_pattern_alike(
+    width: float, expected: list[tuple[str, float]]
+) -> None:
+    """A = (0.5, 0.5), B = (12,): PLATEAU's atlases give such rules (a whole wall a 'window')."""
+    assert fitted((0.5, 0.5), (12.0,), width) == expected  # both rounded to 0.1 mm
+
+
+def test_a_rule_with_no_insertable_repeats_its_piece() -> None:
+    """m = 0: a 2 m plain piece on 9 m repeats 5 times (1.8 m each, scale 0.9, nearer 1 than
+    4 times 2.25 m), where equations 8-9 stretch one piece over 9 m."""
+    assert fitted((2.0,), (), 9) == [("W0", 1.8)] * 5

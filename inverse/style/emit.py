@@ -46,6 +46,8 @@ from .model import OUTWARD, WALLS, Block, Capture, Face
 
 MIN_PIECE = 0.001  # metres: a scalable piece this short still takes its share (no 0 / 0)
 RECESS = 0.02  # metres: a face set back less than this is flush with its wall
+MAX_SR = 2.0  # walls between windows stretch at most this much (or shrink to 1 / MAX_SR)
+MIN_REPEAT = 0.5  # metres: a repeated plain piece (a rule with no insertable) is at least this
 DEEPEST = 0.9  # a recess is at most this fraction of the block's extent behind its wall
 
 
@@ -104,15 +106,29 @@ def fit_rules(
     params: tuple[str, ...] = (),
 ) -> list[str]:
     """Rules realising split_h / split_v (equations 8-9) of a rule A (scalable), B (insertable)
-    along ``axis``: ``name(params)`` fills its scope with x whole patterns and the tail."""
+    along ``axis``: ``name(params)`` fills its scope with x whole patterns and the tail.
+
+    Two deviations, both for the texture's sake where the equations leave a piece stretched
+    far beyond the density it was photographed at (PLATEAU: a crop of 2 pixels over 8 m).
+    When not one insertable fits (x = 0 and y = 0) equation 8 leaves a1 alone stretched over
+    the whole face, and when equation 9's Sr is above MAX_SR or below 1 / MAX_SR (a pattern of
+    a 12.45 m "window" and 0.45 m of wall on a 24 m face: Sr = 12.7) the walls between windows
+    swell or vanish; in both cases the face takes the nearest whole number of patterns (at
+    least one), every piece scaled alike (``Scaled``: a floating repeat of a1 b1 .. a(m+1)), so
+    it shows the source's pieces in their order and proportions.  And a rule with no insertable
+    (m = 0) repeats its one scalable piece, each about a1 long (a floating repeat; MIN_REPEAT at
+    least), rather than stretching it once over the scope."""
     a = [max(MIN_PIECE, v) for v in scalable]
     b = list(insertable)
     m = len(b)
     size = f"scope.s{axis}"
     head = ", ".join(params)
     lead = head + ", " if head else ""
-    if m == 0:  # no insertable element: one scalable piece stretched over the whole scope
-        return [f"{name}{_params(params)} --> {scalable_piece[0]}"]
+    if m == 0:  # no insertable element: the scalable piece, repeated (see the docstring)
+        return [
+            f"{name}{_params(params)} --> split({axis}) "
+            f"{{ ~{num(max(a[0], MIN_REPEAT))}: {scalable_piece[0]} }}*"
+        ]
     pattern = num(sum(a) + sum(b))
     cases = []
     for y in range(m, -1, -1):
@@ -124,6 +140,8 @@ def fit_rules(
             cases.append(
                 f"case x > 0 and abs({alt} - 1) < abs({sr} - 1): {name}Run({lead}x - 1, {m}, {alt})"
             )
+        if not y:  # not one insertable fits: the whole pattern scaled (see the docstring)
+            cases.append(f"case x == 0: {name}Scaled{_params(params)}")
         guard = f"case {rest} >= {num(sum(b[:y]))}: " if y else "else: "
         cases.append(f"{guard}{name}Run({lead}x, {y}, {sr})")
     whole = [f"{num(a[0])} * sr: {scalable_piece[0]}"]
@@ -133,7 +151,8 @@ def fit_rules(
             f"{num(a[i + 1])} * sr: {scalable_piece[i + 1]}",
         ]
     runs = [
-        f"case x > 0: split({axis}) {{ {' | '.join(whole)} | ~1: {name}Run({lead}x - 1, y, sr) }}"
+        f"case sr > {num(MAX_SR)} or sr < {num(1 / MAX_SR)}: {name}Scaled{_params(params)}",
+        f"case x > 0: split({axis}) {{ {' | '.join(whole)} | ~1: {name}Run({lead}x - 1, y, sr) }}",
     ]
     for y in range(m, -1, -1):
         tail = [f"~{num(a[0])}: {scalable_piece[0]}"]
@@ -144,8 +163,15 @@ def fit_rules(
             ]
         guard = f"case y == {y}: " if y else "else: "
         runs.append(f"{guard}split({axis}) {{ {' | '.join(tail)} }}")
+    scaled = [f"~{num(a[0])}: {scalable_piece[0]}"]
+    for i in range(m):
+        scaled += [
+            f"~{num(b[i])}: {insertable_piece[i]}",
+            f"~{num(a[i + 1])}: {scalable_piece[i + 1]}",
+        ]
     return [
         f"{name}{_params(params)} --> {name}Fit({lead}floor({size} / {pattern}))",
+        f"{name}Scaled{_params(params)} --> split({axis}) {{ {' | '.join(scaled)} }}*",
         f"{name}Fit({lead}x) --> " + " | ".join(cases),
         f"{name}Run({lead}x, y, sr) --> " + " | ".join(runs),
     ]
@@ -214,8 +240,8 @@ class _Sheet:
             self.lines += fit_rules(
                 name, "y", rows.scalable, rows.insertable, row_pieces, line_pieces
             )
-        else:
-            self.lines.append(f"{name} --> {cols}")
+        else:  # no window row: the face's own height repeats (as fit_rules does with m = 0)
+            self.lines.append(f"{name} --> split(y) {{ ~{num(face.height * metres)}: {cols} }}*")
         params = ("row",) if many else ()
         wall_pieces = [piece("Wall", c, k) for k, c in enumerate(walls)]
         bay_pieces = [piece("Window", c, k) for k, c in enumerate(bays)]
