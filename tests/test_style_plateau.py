@@ -47,14 +47,15 @@ def check(mass: Path, styled: Path, plain_faces: bool) -> None:
     """What a user relies on: the mass's shape kept (bounds within 5 cm, no vertex more than
     5 cm outside it) and its walls covered by images on every side.  A building some of whose
     walls have no photograph in the source (the water tower's trestle legs) keeps their plain
-    colour, so there a side is covered mostly rather than wholly.  Under 15 % of the textured
-    area is an image stretched below 1 px/m (measured 0-14 %: a crop of a pixel or two that
-    equation 9 stretches over a face narrower than one window bay)."""
+    colour, so there a side is covered mostly rather than wholly.  Under 10 % of the textured
+    area is an image stretched below 1 px/m (measured: 0 on 27 of the 30 models; 3-7 % for the
+    water tower, whose own photographs give some faces under 1 px/m; up to 50 % before the
+    wall bands were cut at the window columns)."""
     np.testing.assert_allclose(bounds(styled), bounds(mass), atol=0.05)
     assert len(outside(mass, styled, tol=0.05)) == 0
     cover = wall_cover(mass, styled)
     assert min(cover.values()) > (0.75 if plain_faces else 0.99), cover
-    assert share_below(styled, 1.0) < 0.15
+    assert share_below(styled, 1.0) < 0.10
 
 
 def test_one_building_by_the_command_line(tmp_path: Path, masses: dict[str, Path]) -> None:

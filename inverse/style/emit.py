@@ -291,14 +291,13 @@ class _Sheet:
                     pieces.append(f"~{num(span * metres)}: {rule}")
                     continue
                 # The notch's ceiling (floor) at the block's top (bottom) would lie in the roof
-                # (the block below's roof), which closes it, and two coplanar faces flicker in
-                # any renderer that draws both sides; on the ground the floor stays (a block
-                # has no bottom face: a view from above saw through the notch).  Its sides
+                # (the block below's roof, or the bottom block's floor), which closes it, and
+                # two coplanar faces flicker in any renderer that draws both sides.  Its sides
                 # (jambs) run from the neighbour face's depth to its own, and only where the
                 # neighbour is shallower: at the wall's end the next wall closes it, and the
                 # deeper of two neighbours alone has the wall between them.
                 colour = f'"{_hex(f.color)}"'
-                top, bottom = int(at < len(block.levels) - 1), int(at > 0 or b == 0)
+                top, bottom = int(at < len(block.levels) - 1), int(at > 0)
                 parts = [f"[ {self.p}Reveal({d}, {top}, {bottom}, {colour}) ]"]
                 for side, n in (("L", j - 1), ("R", j + 1)):
                     if 0 <= n < len(on) and depths[n][0] < depth - RECESS:
@@ -368,9 +367,10 @@ class _Sheet:
                 f"{p}Block{k}Mass --> {p}Block{k}Walls(scope.sx / {num(width * cap.scale)} "
                 f"* recess_x, scope.sz / {num(depth * cap.scale)} * recess_z)"
             )
+            floor = f"{p}Roof" if k == 0 else "NIL"  # the ground closes the notches at its foot
             self.lines.append(
                 f"{p}Block{k}Walls(kx, kz) --> comp(f) {{ {' | '.join(walls)} | top: {p}Roof "
-                "| bottom: NIL }"
+                f"| bottom: {floor} }}"
             )
             parts.append(f"~{num((block.top - block.bottom) * cap.scale)}: {p}Block{k}")
             for what, size in zip(("width", "height", "depth"), block.size, strict=True):
