@@ -14,6 +14,7 @@ import bgr
 from bgr.grammar.formatter import format_source
 from bgr.inverse.style.capture import infer_style
 from bgr.inverse.style.emit import split_rules, split_sizes
+from bgr.inverse.style.emit_splits import MAX_SR
 from bgr.inverse.style.rules import layout
 
 sys.path.insert(0, str(Path(__file__).parent))
@@ -24,6 +25,7 @@ attr w = 10
 terminal WallTile, WindowTile
 Wall(file) --> color("#ff0000") WallTile
 Window(file) --> color("#0000ff") WindowTile
+Bay(w, file) --> case w == 1: Window(file) | else: Wall(file)
 Lot --> s(w, 0, 1) extrude(3) comp(f) { back: Face | all: NIL }
 """
 
@@ -38,8 +40,20 @@ def _windows(grammar: str, width: float) -> np.ndarray:
 
 
 def _expected(A: tuple, B: tuple, width: float) -> np.ndarray:
+    """The windows of rules.layout (equations 8-9), or, where not one window fits or Sr passes
+    MAX_SR (or 1 / MAX_SR), of the nearest whole number n >= 1 of patterns scaled alike
+    (emit_splits.py's deviation)."""
+    pieces = layout(A, B, width)
+    sr = pieces[0][2] / A[0]
+    if not any(kind == "insertable" for kind, _, _ in pieces) or not 1 / MAX_SR <= sr <= MAX_SR:
+        n = max(1, round(width / (sum(A) + sum(B))))
+        k = width / (n * (sum(A) + sum(B)))
+        pattern = [("scalable", A[0] * k)]
+        for a, b in zip(A[1:], B, strict=True):
+            pattern += [("insertable", b * k), ("scalable", a * k)]
+        pieces = [(kind, 0, size) for kind, size in pattern * n]
     at, out = 0.0, []
-    for kind, _, size in layout(A, B, width):
+    for kind, _, size in pieces:
         if kind == "insertable":
             out.append((at, at + size))
         at += size
@@ -50,8 +64,9 @@ def _expected(A: tuple, B: tuple, width: float) -> np.ndarray:
     ("A", "B", "widths"),
     [
         # hand-computed: P = 4; W = 9: x = 2, y = 0, Sr = 1, windows at 1-3 and 5-7;
-        # W = 10.5: x = 2, the tail b1 fits (y = 1), Sr = 0.75, windows at 0.75, 4.25, 7.5
-        ((1.0, 1.0), (2.0,), (9.0, 10.5, 4.0, 3.0, 1.5)),
+        # W = 10.5: x = 2, the tail b1 fits (y = 1), Sr = 0.75, windows at 0.75, 4.25, 7.5;
+        # W = 1.5: no window fits (x = y = 0), one pattern x 1.5 / 4; W = 12.5: Sr = 2.25
+        ((1.0, 1.0), (2.0,), (9.0, 10.5, 4.0, 3.0, 1.5, 12.5)),
         ((0.5, 1.2, 0.8), (1.0, 0.6), (2.0, 6.1, 10.0, 13.3)),
         ((1.15, 1.8, 1.8, 1.15), (0.7, 0.7, 0.7), (3.6, 8.0, 14.0, 20.0)),
     ],
@@ -59,7 +74,7 @@ def _expected(A: tuple, B: tuple, width: float) -> np.ndarray:
 def test_split_rules_lay_out_windows_as_split_h(A, B, widths):
     m = len(B)
     crops = [f'"s{k}"' for k in range(m + 1)] + [f'"i{k}"' for k in range(m)]
-    call = f"Face --> SplitX{m}({', '.join(split_sizes(A, B) + crops)})\n"
+    call = f"Face --> SplitX{m}({', '.join(split_sizes(A, B) + crops)}, 1)\n"
     grammar = HEADER + call + "\n".join(split_rules("x", m)) + "\n"
     for width in widths:
         got = _windows(grammar, width)
@@ -71,19 +86,32 @@ def test_split_rules_hand_computed():
     """P = 4.  W = 9: x = 2, b1 does not fit the 1 left (y = 0), Sr = 5 / 5 = 1.  W = 10.5:
     x = 2, the tail takes b1 (2.5 >= 2, y = 1), Sr = (10.5 - 4 - 2) / (2 * 2 + 2) = 0.75:
     patterns of 3.5, the tail's window after 7 + 0.75."""
-    grammar = HEADER + 'Face --> SplitX1(1, 1, 2, 4, 2, 1, 2, "s0", "s1", "i0")\n'
+    grammar = HEADER + 'Face --> SplitX1(1, 1, 2, 4, 2, 1, 2, "s0", "s1", "i0", 1)\n'
     grammar += "\n".join(split_rules("x", 1)) + "\n"
     assert np.allclose(_windows(grammar, 9.0), [[1, 3], [5, 7]])
     assert np.allclose(_windows(grammar, 10.5), [[0.75, 2.75], [4.25, 6.25], [7.75, 9.75]])
 
 
 def test_a_tail_of_no_window_makes_no_empty_piece():
-    """The tail is one split whose pieces beyond y have size 0: none of them becomes a shape."""
-    grammar = HEADER + 'Face --> SplitX1(1, 1, 2, 4, 2, 1, 2, "s0", "s1", "i0")\n'
+    """The tail is one split whose pieces beyond y have size 0: none of them becomes a shape.
+    W = 5: x = 1, the 1 m left holds no window (y = 0), Sr = 3 / 3 = 1: the pattern's three
+    quads and the tail's one wall, the tail's window and last wall (size 0) dropped."""
+    grammar = HEADER + 'Face --> SplitX1(1, 1, 2, 4, 2, 1, 2, "s0", "s1", "i0", 1)\n'
     grammar += "\n".join(split_rules("x", 1)) + "\n"
-    mesh = bgr.derive(bgr.load(grammar), attrs={"w": 1.5}, start="Lot").mesh
-    assert len(mesh.faces) == 2  # one wall quad: x = 0, y = 0, the window's size 0 dropped
-    assert np.allclose(np.ptp(mesh.vertices[:, 0]), 1.5)
+    mesh = bgr.derive(bgr.load(grammar), attrs={"w": 5.0}, start="Lot").mesh
+    assert len(mesh.faces) == 8
+    assert np.allclose(np.ptp(mesh.vertices[:, 0]), 5.0)
+
+
+def test_a_face_narrower_than_a_window_takes_the_pattern_scaled():
+    """W = 1.5 < b1 = 2: equation 8 would stretch a1 over the face; the pattern scaled by
+    1.5 / 4 keeps its window (0.375 .. 1.125), and a wall band's row (w = 0) shows the same
+    piece as a wall."""
+    grammar = HEADER + 'Face --> SplitX1(1, 1, 2, 4, 2, 1, 2, "s0", "s1", "i0", 1)\n'
+    grammar += "\n".join(split_rules("x", 1)) + "\n"
+    assert np.allclose(_windows(grammar, 1.5), [[0.375, 1.125]])
+    band = grammar.replace('"i0", 1)', '"i0", 0)')
+    assert _windows(band, 1.5).shape == (0, 2)
 
 
 def test_the_sheet_is_what_bgr_fmt_prints(tmp_path):

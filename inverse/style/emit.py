@@ -7,26 +7,23 @@ into the source's blocks at their relative heights, sets each block back as the 
 front, right, back and left): the wall's levels at their relative heights, each level's faces at
 their relative widths, a face set back from the block's outer boundary recessed by its depth.
 
-Each face is cut along y by its level group's vertical rule and each window row along x by its
-stack group's horizontal rule, both **exactly as equations 8 and 9** (section 5.2.3), in the
+A recess keeps its depth in metres, as a window keeps its size, but shrinks with the block's
+extent across the wall (``k``: the target block's depth behind the wall over the source's, at
+most 1; times ``recess_x`` / ``recess_z``, which bgr restyle lowers on a mass that is not a box
+to its thinnest part over its extent), and reaches at most DEEPEST of the block: so a reveal
+stays inside any target.  Scaled by the wall's height or width instead, a 1 m recess of a 7 m
+block became 8.5 m on a 60 m slab and its reveal ran through the building and out of the
+opposite wall.  A reveal's sides take the recessed face's colour, and only where needed: no
+ceiling at the block's top or floor at its bottom (the roofs close them), jambs only beside a
+shallower neighbour (see :meth:`_Sheet.wall`).
+
+Each face is cut along y by its level group's vertical rule into rows (window rows and the wall
+bands between them) and each row along x by its stack group's horizontal rule, both **exactly
+as equations 8 and 9** (section 5.2.3, with the two deviations of emit_splits.py), in the
 grammar's own terms so that any mass can take it.  The equations are written once per number m
-of insertable pieces, the sizes and crops being parameters:
-
-    SplitX2(a0, a1, a2, b0, b1, p, c1, c2, d0, d1, d2, s0, s1, s2, i0, i1) -->
-        SplitX2Fit(.., floor(scope.sx / p))                 x whole patterns of length p
-    SplitX2Fit(.., x) --> SplitX2Y(.., x, (scope.sx - x * p >= c1 ? 1 : 0) + (.. >= c2 ? 1 : 0))
-    SplitX2Y(.., x, y) --> case (a tie, y = 0): .. | else: SplitX2Run(a.., b.., s.., i.., x, y, Sr)
-    SplitX2Run(.., x, y, sr) --> case x > 0: split(x) { a0 * sr: Wall(s0) | b0: Window(i0) | ..
-                                                        | ~1: SplitX2Run(.., x - 1, y, sr) }
-        | else: split(x) { ~a0: Wall(s0) | (y > 0 ? b0 : 0): Window(i0) | .. }   the tail
-
-(c_y and d_y the sums of b0 .. b(y-1) and a0 .. ay, see :func:`split_rules`).  A group's rule
-is one line of its numbers (``Bays3(s0, s1, i0) --> SplitX1(0.8, 0.8, 1.2, 2.8, 1.2, 0.8, 1.6,
-s0, s1, i0)``), and a face one line of its crops per window row (``F7Row0 --> Bays3("..", "..",
-"..")``; along y the window rows are rules handed to the group's rule).  So the text grows with
-the crops, not with faces x pieces x tail cases: PLATEAU's 10 buildings took 22,900 lines
-(parsing and formatting them was most of a capture's time) and take 4,300, deriving the same
-meshes (benchmarked in bench/style.py, docs/benchmarks.md).
+of insertable pieces (emit_splits.py), a group's rule is one line of its sizes and a face's row
+one line of its crops (``F7Row0 --> Bays3(1, "..", "..", "..")``), so the text grows with the
+crops, not with faces x pieces x tail cases.
 
 Sizes are metres: windows (insertable pieces) keep the size they had, walls (scalable pieces)
 stretch by Sr.  Every piece shows its crop of the face's own texture (``Window("...")`` or
@@ -38,7 +35,6 @@ from __future__ import annotations
 
 import hashlib
 import io
-from collections.abc import Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -47,25 +43,22 @@ from bgr.grammar.formatter import (
     HEAD_WIDTH,
     INDENT,
     WIDTH,
-    format_number,
     format_source,
     format_string,
 )
 from bgr.grammar.safe_text import comment_line, comment_text
 
+from .emit_splits import group_body, num, split_rules, split_sizes
 from .groups import RIGHTWARD, Groups, along
 from .model import OUTWARD, WALLS, Block, Capture, Face
 from .rules import Rule
 
-MIN_PIECE = 0.001  # metres: a scalable piece this short still takes its share (no 0 / 0)
+__all__ = ["Crops", "num", "split_rules", "split_sizes", "style_text"]
+
 RECESS = 0.02  # metres: a face set back less than this is flush with its wall
 PART = 0.98  # a comp(f) face narrower than this share of its side is one of several faces
+DEEPEST = 0.9  # a recess is at most this fraction of the block's extent behind its wall
 ROOF = "#9a9a9a"  # a roof's colour when the source's is unknown (a textured roof)
-
-
-def num(x: float, digits: int = 4) -> str:
-    """A .bgr number rounded to ``digits`` decimals (millimetres for metres)."""
-    return format_number(round(float(x), digits) + 0.0)
 
 
 @dataclass
@@ -111,90 +104,6 @@ def _pixels(cuts: list[tuple[str, float, float]], n: int) -> list[tuple[str, int
     return out
 
 
-def split_sizes(scalable: Sequence[float], insertable: Sequence[float]) -> list[str]:
-    """The numbers a group hands its Split rule: A (a0 .. am, each at least MIN_PIECE), B (b0 ..
-    b(m-1)), the pattern's length P, the sums c1 .. cm of b0 .. b(y-1) and d0 .. dm of a0 ..
-    ay.  The sums are rounded here, once, like the sizes: summed by the grammar they would
-    carry float error, and a target exactly as wide as a sum (the source's own mass) would
-    fall on either side of an equation 8 comparison."""
-    a = [max(MIN_PIECE, v) for v in scalable]
-    b = list(insertable)
-    sums = [sum(a) + sum(b)] + [sum(b[:y]) for y in range(1, len(b) + 1)]
-    sums += [sum(a[: y + 1]) for y in range(len(a))]
-    return [num(v) for v in a + b + sums]
-
-
-def split_rules(axis: str, m: int) -> list[str]:
-    """Equations 8-9 (split_h along x, split_v along y) once for every rule of ``m >= 1``
-    insertable pieces: ``SplitX<m>(a0 .. am, b0 .. b(m-1), p, c1 .. cm, d0 .. dm, s0 .. sm,
-    i0 .. i(m-1))`` takes the sizes of A (scalable, metres) and B (insertable) and their sums
-    (:func:`split_sizes`), the crops of the scalable pieces (``Wall(s)``) and the insertable
-    pieces: crops of windows along x (``Window(i)``), the window rows' rules along y.  A group's
-    rule is then one line of its numbers, and a face's one line of its crops.
-
-    ``..Fit`` takes x = floor(W / P) whole patterns; ``..Y`` the largest tail y whose insertable
-    pieces b0 .. b(y-1) fit what is left (the count of the sums c_k the rest holds: they grow
-    with k), Sr filling the scope, and a tie in the window count when no tail fits goes to the
-    layout whose walls stretch least; ``..Run`` lays the whole patterns one by one, then the
-    tail [a0 b0 .. a(y-1) b(y-1) ay] as one split whose pieces beyond y have size 0 (a split
-    makes no shape of size 0).  Every choice is one expression rather than a case per y, so the
-    text grows with m, not m^2 (the rules pass every parameter on: a case per y made a rule
-    of 74 windows 70,000 tokens long)."""
-    a = [f"a{k}" for k in range(m + 1)]
-    b = [f"b{k}" for k in range(m)]
-    c = [f"c{k}" for k in range(1, m + 1)]  # c_y = b0 + .. + b(y-1)
-    d = [f"d{k}" for k in range(m + 1)]  # d_y = a0 + .. + ay
-    s = [f"s{k}" for k in range(m + 1)]
-    i = [f"i{k}" for k in range(m)]
-    scalable = [f"Wall({v})" for v in s]
-    inserted = [f"Window({v})" for v in i] if axis == "x" else i
-    name = f"Split{axis.upper()}{m}"
-    every = ", ".join(a + b + ["p"] + c + d + s + i)
-    pieces = ", ".join(a + b + s + i)  # what laying the pieces out needs
-    size = f"scope.s{axis}"
-    sum_a, sum_b = d[m], c[m - 1]
-    # y: how many of c1 <= c2 <= .. <= cm the rest holds, i.e. the largest y with c_y <= rest
-    y = _balanced([f"({size} - x * p >= {v} ? 1 : 0)" for v in c])
-    tail_b = _balanced([f"(y == {k} ? {v} : 0)" for k, v in enumerate(c, 1)])
-    tail_a = _balanced([f"(y == {k} ? {v} : 0)" for k, v in enumerate(d)])
-    sr = f"({size} - x * {sum_b} - {tail_b}) / (x * {sum_a} + {tail_a})"
-    alt = f"({size} - x * {sum_b}) / (x * {sum_a})"
-    sr0 = f"({size} - x * {sum_b}) / (x * {sum_a} + {d[0]})"
-    whole = [f"{a[0]} * sr: {scalable[0]}"]
-    tail = [f"~{a[0]}: {scalable[0]}"]
-    for k in range(m):
-        whole += [f"{b[k]}: {inserted[k]}", f"{a[k + 1]} * sr: {scalable[k + 1]}"]
-        tail += [
-            f"(y > {k} ? {b[k]} : 0): {inserted[k]}",
-            f"~(y > {k} ? {a[k + 1]} : 0): {scalable[k + 1]}",
-        ]
-    whole.append(f"~1: {name}Run({pieces}, x - 1, y, sr)")
-    fewer = f"{name}Run({pieces}, x - 1, {m}, {alt})"
-    return [
-        f"{name}({every}) --> {name}Fit({every}, floor({size} / p))",
-        f"{name}Fit({every}, x) --> {name}Y({every}, x, {y})",
-        # a tie in the window count (no tail fits): the layout whose walls stretch least
-        f"{name}Y({every}, x, y) --> "
-        f"case y == 0 and x > 0 and abs({alt} - 1) < abs({sr0} - 1): {fewer} "
-        f"| else: {name}Run({pieces}, x, y, {sr})",
-        f"{name}Run({pieces}, x, y, sr) --> "
-        f"case x > 0: split({axis}) {{ {' | '.join(whole)} }} "
-        f"| else: split({axis}) {{ {' | '.join(tail)} }}",
-    ]
-
-
-def _balanced(terms: list[str]) -> str:
-    """A sum of terms nested log2(n) deep: the checker limits an expression's depth."""
-    if len(terms) == 1:
-        return terms[0]
-    half = len(terms) // 2
-    return f"({_balanced(terms[:half])} + {_balanced(terms[half:])})"
-
-
-def _params(params: tuple[str, ...]) -> str:
-    return f"({', '.join(params)})" if params else ""
-
-
 def _hex(color: tuple[int, int, int]) -> str:
     return "#" + "".join(f"{int(c):02x}" for c in color)
 
@@ -233,16 +142,17 @@ def _render(lines: list[str]) -> str:
     return "\n".join(out) + "\n"
 
 
-def _block_rule(head: str, entries: list[str]) -> _Raw:
+def _block_rule(head: str, entries: list[str], repeat: str = "") -> _Raw:
     """``head { e1 | e2 .. }`` in the formatter's layout: one line when it fits in its width,
     else one entry a line, each after the first behind ``| ``.  ``head`` is a rule head of at
-    most HEAD_WIDTH columns and one operation that takes the block, the entries formatted."""
-    line = f"{head} {{ {' | '.join(entries)} }}"
+    most HEAD_WIDTH columns and one operation that takes the block, the entries formatted;
+    ``repeat`` "*" makes the split a floating repeat."""
+    line = f"{head} {{ {' | '.join(entries)} }}{repeat}"
     if len(line) <= WIDTH:
         return _Raw(line)
     rows = [f"{head} {{", f"{INDENT}{entries[0]}"]
     rows += [f"{INDENT}| {e}" for e in entries[1:]]
-    return _Raw("\n".join(rows + ["}"]))
+    return _Raw("\n".join(rows + ["}" + repeat]))
 
 
 class _Sheet:
@@ -262,21 +172,18 @@ class _Sheet:
 
     def group_rule(self, name: str, axis: str, rule: Rule) -> str:
         """One group's rule, written once for all its faces: ``name(s0 .., i0 ..) -->
-        Split<axis><m>(its sizes, s0 .., i0 ..)``, the crops (or, along y, the window rows'
-        rules) being the face's parameters.  Along x a group without windows is one wall."""
+        Split<axis><m>(its sizes, s0 .., i0 ..)`` (along x ``name(w, s0 .., i0 ..)``), the
+        crops (along y, the face's rows) being the face's parameters (emit_splits.py)."""
         if name in self.written:
             return name
         self.written.add(name)
         m = len(rule.insertable)
-        s = [f"s{k}" for k in range(m + 1)]
-        i = [f"i{k}" for k in range(m)]
-        if m == 0:
-            self.shared.append(_Raw(f"{name}(s0) --> Wall(s0)"))
-            return name
-        self.splits.add((axis, m))
-        args = ", ".join(split_sizes(rule.scalable, rule.insertable) + s + i)
-        head = f"{name}({', '.join(s + i)})"
-        line = f"{head} --> Split{axis.upper()}{m}({args})"
+        args = [f"s{k}" for k in range(m + 1)] + [f"i{k}" for k in range(m)]
+        if m:
+            self.splits.add((axis, m))
+        flag = ["w"] if axis == "x" else []
+        head = f"{name}({', '.join(flag + args)})"
+        line = f"{head} --> {group_body(axis, rule.scalable, rule.insertable, args + flag)}"
         self.shared.append(_Raw(line) if len(head + " -->") <= HEAD_WIDTH else line)
         return name
 
@@ -313,69 +220,117 @@ class _Sheet:
         col_px = _pixels(g.column_cuts[v], tw)
         if not rows.insertable:  # no window row: the bays run the face's full height
             row_px = [("insertable", 0, th)]
-        bands = [(r0, r1) for kind, r0, r1 in row_px if kind == "scalable"]
-        lines = [(r0, r1) for kind, r0, r1 in row_px if kind == "insertable"]
         walls = [(c0, c1) for kind, c0, c1 in col_px if kind == "scalable"]
         bays = [(c0, c1) for kind, c0, c1 in col_px if kind == "insertable"]
 
         def crop(r: tuple[int, int], c: tuple[int, int]) -> str:
             return format_string(self.crops.add(texture[r[0] : r[1], c[0] : c[1]]))
 
+        # Every row, window row or wall band, is cut by the stack's columns (a band's pieces
+        # all walls: w = 0): a band cropped whole and stretched over a wider face smeared (a
+        # 29-pixel band of a 7 m face over a 30 m slab is 1 pixel a metre); cut at the window
+        # columns, it repeats with them at the density it was photographed at.
         bays_rule = self.group_rule(f"{self.p}Bays{v}", "x", columns)
-        calls = [
-            f"{bays_rule}({', '.join([crop(r, c) for c in walls] + [crop(r, c) for c in bays])})"
-            for r in lines
-        ]
-        if not rows.insertable:
-            self.lines.append(_Raw(f"{name} --> {calls[0]}"))
-            return name
-        args = [crop(r, (0, tw)) for r in bands] + [f"{name}Row{j}" for j in range(len(lines))]
-        rows_rule = self.group_rule(f"{self.p}Rows{h}", "y", rows)
-        self.lines.append(_Raw(f"{name} --> {rows_rule}({', '.join(args)})"))
-        self.lines += [_Raw(f"{name}Row{j} --> {call}") for j, call in enumerate(calls)]
+        row_lines = []
+        for j, (kind, r0, r1) in enumerate(row_px):
+            flag = "1" if kind == "insertable" else "0"
+            crops = [crop((r0, r1), c) for c in walls] + [crop((r0, r1), c) for c in bays]
+            row_lines.append(_Raw(f"{name}Row{j} --> {bays_rule}({', '.join([flag, *crops])})"))
+        if rows.insertable:
+            args = [f"{name}Row{j}" for j, r in enumerate(row_px) if r[0] == "scalable"]
+            args += [f"{name}Row{j}" for j, r in enumerate(row_px) if r[0] == "insertable"]
+            rows_rule = self.group_rule(f"{self.p}Rows{h}", "y", rows)
+            self.lines.append(_Raw(f"{name} --> {rows_rule}({', '.join(args)})"))
+        else:  # the face's own height repeats, as a rule of m = 0 does (emit_splits.py)
+            repeat = f"~{num(face.height * metres)}: {name}Row0"
+            self.lines.append(_block_rule(f"{name} --> split(y)", [repeat], "*"))
+        self.lines += row_lines
         return name
 
     def wall(self, b: int, block: Block, w: int, below_gap: float | None) -> str:
-        """Rules of one wall of a block: levels, then faces at relative widths, recessed."""
+        """Rules of one wall of a block: levels, then faces at relative widths, recessed (see
+        the module's docstring); ``name(k)``, k the block's stretch across the wall."""
         name = f"{self.p}B{b}{WALLS[w].capitalize()}"
         faces = block.walls[w]
         metres = self.capture.scale
         xmin, xmax, zmin, zmax = block.box
         outer = (-zmin, xmax, zmax, -xmin)[w]  # the outer boundary along OUTWARD[w]
-        width = (xmax - xmin) if w in (0, 2) else (zmax - zmin)
+        behind = ((zmax - zmin) if w in (0, 2) else (xmax - xmin)) * metres
         levels = []
-        for level in block.levels:
+        for at, level in enumerate(block.levels):
             on = [f for f in faces if f.level == level and along(f)[1] - along(f)[0] > 1e-9]
             on.sort(key=lambda f: along(f)[0])
-            pieces = []
+            depths = []  # each face's recess: (metres at the source, its .bgr expression)
             for f in on:
+                # a level wider than the box that starts its block can put a face beyond
+                # the opposite wall: no recess reaches past DEEPEST of the block
+                depth = min((outer - float(f.start @ OUTWARD[w])) * metres, DEEPEST * behind)
+                d = f"{num(depth)} * min(1, k)"
+                if below_gap is not None and depth < below_gap:  # the overhang fix (5.1.2)
+                    d = f"min({d}, 0.9 * {num(below_gap)} * k)"
+                depths.append((depth, d) if depth > RECESS else (0.0, "0"))
+            pieces = []
+            for j, f in enumerate(on):
                 span = along(f)[1] - along(f)[0]
-                depth = (outer - float(f.start @ OUTWARD[w])) * metres
                 rule = self.face(f)
-                if depth > RECESS:
-                    d = f"{num(depth)} * kh"
-                    if below_gap is not None and depth < below_gap:  # the overhang fix (5.1.2)
-                        d = f"min({d}, 0.9 * {num(below_gap)} * kw)"
-                    back = f"-{d}" if d.startswith("min(") else f"-({d})"
-                    pieces.append(
-                        f"~{num(span * metres)}: [ {self.p}Reveal({d}) ] t(0, 0, {back}) {rule}"
-                    )
-                else:
+                depth, d = depths[j]
+                if not depth:
                     pieces.append(f"~{num(span * metres)}: {rule}")
+                    continue
+                # The notch's ceiling (floor) at the block's top (bottom) would lie in the roof
+                # (the block below's roof, or the bottom block's floor), which closes it, and
+                # two coplanar faces flicker in any renderer that draws both sides.  Its sides
+                # (jambs) run from the neighbour face's depth to its own, and only where the
+                # neighbour is shallower: at the wall's end the next wall closes it, and the
+                # deeper of two neighbours alone has the wall between them.
+                colour = f'"{_hex(f.color)}"'
+                top, bottom = int(at < len(block.levels) - 1), int(at > 0)
+                parts = [f"[ {self.p}Reveal({d}, {top}, {bottom}, {colour}) ]"]
+                for side, n in (("L", j - 1), ("R", j + 1)):
+                    if 0 <= n < len(on) and depths[n][0] < depth - RECESS:
+                        near = depths[n][1]
+                        parts.append(
+                            f"[ t(0, 0, -({near})) {self.p}Jamb{side}(({d}) - ({near}), {colour}) ]"
+                        )
+                pieces.append(f"~{num(span * metres)}: {' '.join(parts)} t(0, 0, -({d})) {rule}")
             if not pieces:
                 pieces = ["~1: Plain"]
             lname = f"{name}L{level}"
-            self.lines.append(_block_rule(f"{lname}(kh, kw) --> split(x)", pieces))
+            head = f"{lname}(k) --> split(x)"
+            if any(d for d, _ in depths):  # its expressions as bgr fmt prints them
+                self.lines.append(f"{head} {{ {' | '.join(pieces)} }}")
+            else:
+                self.lines.append(_block_rule(head, pieces))
             span = (self.capture.floors[level + 1] - self.capture.floors[level]) * metres
-            levels.append(f"~{num(span)}: {lname}(kh, kw)")
-        height = (block.top - block.bottom) * metres
-        scales = f"scope.sy / {num(height)}, scope.sx / {num(width * metres)}"
-        self.lines.append(_Raw(f"{name} --> {name}Levels({scales})"))
-        self.lines.append(_block_rule(f"{name}Levels(kh, kw) --> split(y)", levels))
+            levels.append(f"~{num(span)}: {lname}(k)")
+        self.lines.append(_block_rule(f"{name}(k) --> split(y)", levels))
         return name
 
-    def side(self, b: int, block: Block, w: int, full_rule: str) -> str:
-        """The selector of comp(f)'s faces looking the way of wall ``w``: ``full_rule`` (the
+    def stack(self) -> str:
+        """The body of ``Stack``: every source block on one target block, without setbacks (bgr
+        restyle gives it to a mass of one block; see restyle.py).  The bottom block keeps its
+        height in metres, and so does the top one when there are three or more; the blocks
+        between them stretch to fill the rest, or, with two blocks, the top one does (the
+        storeys a taller building repeats are its middle ones).  A target lower than the
+        kept heights takes every block at its relative height instead."""
+        cap, p = self.capture, self.p
+        heights = [(b.top - b.bottom) * cap.scale for b in cap.blocks]
+        n = len(heights)
+        if n == 1:
+            return f"{p}Block0Mass"
+        kept = [0, n - 1] if n > 2 else [0]
+        fixed = sum(heights[j] for j in kept)
+        absolute = " | ".join(
+            f"{'' if j in kept else '~'}{num(h)}: {p}Block{j}Mass" for j, h in enumerate(heights)
+        )
+        relative = " | ".join(f"~{num(h)}: {p}Block{j}Mass" for j, h in enumerate(heights))
+        return (
+            f"case scope.sy > {num(fixed)}: split(y) {{ {absolute} }} "
+            f"| else: split(y) {{ {relative} }}"
+        )
+
+    def side(self, block: Block, w: int, wall: str, k: str) -> str:
+        """The selector of comp(f)'s faces looking the way of wall ``w``: ``wall(k)`` (the
         whole wall, faces at relative widths, set-back ones recessed) for a face as wide as the
         block's side, as a box mass or the lot's block gives; else, where the block's outline is
         not a rectangle, one of its captured faces looking that way (a jog of an L included,
@@ -391,12 +346,11 @@ class _Sheet:
         full = (xmax - xmin) if w in (0, 2) else (zmax - zmin)
         shares = [float(np.hypot(*(first.end - first.start))) / full for first, _ in columns]
         if len(columns) <= 1 and all(r >= PART for r in shares):
-            return full_rule
-        name = f"{full_rule}Side"
-        cases = [f"case scope.sx >= {num(PART)} * full: {full_rule}"]
+            return f"{wall}({k})"
+        cases = [f"case scope.sx >= {num(PART)} * full: {wall}(k)"]
         order = np.argsort(shares, kind="stable")
         for n_, j in enumerate(order):
-            part = f"{full_rule}Part{n_}"
+            part = f"{wall}Part{n_}"
             pieces = []
             for level, face in zip(block.levels, columns[j][1], strict=True):
                 span = (self.capture.floors[level + 1] - self.capture.floors[level]) * metres
@@ -407,8 +361,8 @@ class _Sheet:
                 cases.append(f"case scope.sx < {num(limit)} * full: {part}")
             else:
                 cases.append(f"else: {part}")
-        self.lines.append(f"{name}(full) --> " + " | ".join(cases))
-        return f"{name}({('bw', 'bd')[w % 2]})"
+        self.lines.append(f"{wall}Side(full, k) --> " + " | ".join(cases))
+        return f"{wall}Side({('bw', 'bd')[w % 2]}, {k})"
 
     def building(self) -> None:
         cap, p = self.capture, self.p
@@ -425,7 +379,10 @@ class _Sheet:
                     mine = (-block.box[2], block.box[1], block.box[3], -block.box[0])[w]
                     theirs = (-above.box[2], above.box[1], above.box[3], -above.box[0])[w]
                     gap = (mine - theirs) * cap.scale if mine > theirs else None
-                walls.append(f"{WALLS[w]}: {self.side(k, block, w, self.wall(k, block, w, gap))}")
+                across = "kz" if w in (0, 2) else "kx"  # front and back recess along z
+                walls.append(
+                    f"{WALLS[w]}: {self.side(block, w, self.wall(k, block, w, gap), across)}"
+                )
             xmin, xmax, zmin, zmax = block.box
             fx, fz = (xmin - x0) / (x1 - x0), (zmin - z0) / (z1 - z0)
             sx, sz = (xmax - xmin) / (x1 - x0), (zmax - zmin) / (z1 - z0)
@@ -433,19 +390,37 @@ class _Sheet:
                 f"{p}Block{k} --> t('{num(fx)}, 0, '{num(fz)}) "
                 f"s('{num(sx)}, '1, '{num(sz)}) {p}Block{k}Mass"
             )
-            walls += [f"top: {p}Roof", "bottom: NIL"]
-            if any("(bw)" in w or "(bd)" in w for w in walls):  # the sides' widths for ``side``
-                self.lines.append(_Raw(f"{p}Block{k}Mass --> {p}Block{k}Faces(scope.sx, scope.sz)"))
-                self.lines.append(_block_rule(f"{p}Block{k}Faces(bw, bd) --> comp(f)", walls))
-            else:
-                self.lines.append(_block_rule(f"{p}Block{k}Mass --> comp(f)", walls))
+            floor = f"{p}Roof" if k == 0 else "NIL"  # the ground closes the notches at its foot
+            walls += [f"top: {p}Roof", f"bottom: {floor}"]
+            # k of the walls: the block's stretch across them; bw, bd: its sides' widths
+            width, _, depth = block.size
+            ks = [
+                f"scope.sx / {num(width * cap.scale)} * recess_x",
+                f"scope.sz / {num(depth * cap.scale)} * recess_z",
+            ]
+            params = ["kx", "kz"]
+            if any("Side(" in w for w in walls):
+                ks, params = ks + ["scope.sx", "scope.sz"], params + ["bw", "bd"]
+            self.lines.append(f"{p}Block{k}Mass --> {p}Block{k}Walls({', '.join(ks)})")
+            head = f"{p}Block{k}Walls({', '.join(params)}) --> comp(f)"
+            self.lines.append(_block_rule(head, walls))
             parts.append(f"~{num((block.top - block.bottom) * cap.scale)}: {p}Block{k}")
             for what, size in zip(("width", "height", "depth"), block.size, strict=True):
                 self.consts.append(_Raw(f"const {p}block{k}_{what} = {num(size * cap.scale)}"))
         self.lines.append(_block_rule(f"{p}Building --> split(y)", parts))
+        self.lines.append(f"{p}Stack --> {self.stack()}")
         self.lines.append(
-            f"{p}Reveal(d) --> extrude(-d) comp(f) {{ side: reverseNormals() "
-            'color("#8c8c8c") Plain | all: NIL }'
+            f"{p}Reveal(d, t, b, c) --> extrude(-d) comp(f) {{ front: {p}RevealSide(t, c) "
+            f"| back: {p}RevealSide(b, c) | all: NIL }}"
+        )
+        for side, which in (("L", "left"), ("R", "right")):
+            self.lines.append(
+                f"{p}Jamb{side}(d, c) --> extrude(-max(d, 0)) comp(f) {{ {which}: "
+                f"{p}RevealSide(1, c) | all: NIL }}"
+            )
+        self.lines.append(  # in the recessed face's mean colour, which its sides continue
+            f"{p}RevealSide(keep, c) --> case keep == 1: reverseNormals() color(c) Plain "
+            "| else: NIL"
         )
         roof = _hex(cap.roof) if cap.roof is not None else ROOF
         self.lines.append(f'{p}Roof --> color("{roof}") Plain')
@@ -510,11 +485,17 @@ def style_text(sheets: list[tuple[Capture, Groups]], crops: Crops) -> str:
         out.append("attr style = 0")
     out.append(f"attr height = {num(first.scale, 2)}  # metres; the source's height")
     out.append(
-        "# bgr restyle: the source block a target block takes (-1: the whole building on the lot)"
+        "# bgr restyle: the source block a target block takes (-1: the whole building on the "
+        "lot, -2: all its blocks stacked on the target block)"
     )
     out.append("attr block = -1")
     out.append("attr block_base = 0")
     out.append("attr block_height = 1")
+    out.append(
+        "# bgr restyle: the thinnest part of a target block that is not a box, over its extent"
+    )
+    out.append("attr recess_x = 1")
+    out.append("attr recess_z = 1")
     out.append("")
     out.append("terminal WallTile, WindowTile, Plain")
     starts = []
@@ -524,6 +505,7 @@ def style_text(sheets: list[tuple[Capture, Groups]], crops: Crops) -> str:
             f"case block == {j}: t(0, block_base, 0) extrude(block_height) {p}Block{j}Mass"
             for j in range(len(capture.blocks))
         ]
+        blocks.append(f"case block == -2: t(0, block_base, 0) extrude(block_height) {p}Stack")
         starts.append((p, " | ".join(blocks) + f" | else: extrude(height) {p}Building"))
     if len(starts) == 1:
         out.append(f"Lot --> {starts[0][1]}")
@@ -544,8 +526,10 @@ def style_text(sheets: list[tuple[Capture, Groups]], crops: Crops) -> str:
         "Window(file) --> color(\"#ffffff\") setupProjection(0, scope.xy, '1, '1) projectUV(0) "
         "texture(file) WindowTile"
     )
+    out.append("# a piece of a window column: a window in a window row (w = 1), else a wall")
+    out.append("Bay(w, file) --> case w == 1: Window(file) | else: Wall(file)")
     out.append(
-        "# equations 8 and 9: a group's sizes, then its pieces' crops (along y: its window rows)"
+        "# equations 8 and 9: a group's sizes, then its pieces' crops (along y: the face's rows)"
     )
     for axis, m in sorted(splits):
         out += split_rules(axis, m)

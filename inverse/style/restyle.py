@@ -7,6 +7,12 @@ the source's bottom and the top block its top, the paper's forced matches), and 
 the outline of its first floor, at its base height, extruded to its height by the sheet's
 ``Lot`` rule with ``block`` naming the source block, so that the block's walls are split by that
 block's rules (equations 8 and 9) in the grammar itself.
+
+Deviation: a mass of **one** block from a source of several takes them all, stacked (the
+sheet's ``Stack``: bottom and top blocks at their own heights, those between stretched).  The
+paper's forced matches give the single block both the source's bottom and its top block; taking
+the bottom one alone, as the greedy order would, put a 7 m ground floor's rows eight times up a
+60 m slab and dropped every upper storey of the look.
 """
 
 from __future__ import annotations
@@ -19,6 +25,9 @@ import numpy as np
 from bgr.grammar import nodes as n
 from bgr.grammar.checker import Grammar
 from bgr.grammar.errors import BgrError, Diagnostic
+
+STACK = -2
+"""The sheet's ``block`` value for all source blocks stacked on one target block."""
 
 
 def shape_cost(source: tuple[float, float, float], target: tuple[float, float, float]) -> float:
@@ -105,6 +114,47 @@ def _front_first(ring: np.ndarray) -> np.ndarray:
     return np.roll(ring, -k, axis=0)
 
 
+def thinnest(ring: np.ndarray, samples: int = 5) -> tuple[float, float]:
+    """(r_x, r_z): the footprint's thinnest extent behind its walls facing x (and z) over its
+    bounding box's extent along x (z); 1 for a rectangle.  Each edge is sampled at ``samples``
+    points; from each the polygon is crossed inward along the edge's normal, and the length of
+    the crossing that starts there is its extent behind the wall.  The sheet's recesses are
+    scaled by them (emit.py), so that none reaches through an arm of an L."""
+    import shapely
+
+    ring = np.asarray(ring, float)
+    if len(ring) > 1 and np.allclose(ring[0], ring[-1]):
+        ring = ring[:-1]
+    poly = shapely.Polygon(ring)
+    xmin, zmin, xmax, zmax = poly.bounds
+    extent = np.array([xmax - xmin, zmax - zmin])
+    if len(ring) < 3 or min(extent) <= 0:
+        return 1.0, 1.0
+    edges = np.roll(ring, -1, axis=0) - ring
+    axis = (np.abs(edges[:, 1]) > np.abs(edges[:, 0])).astype(int)  # 0: across x, 1: across z
+    axis = 1 - axis  # an edge along x faces z: its extent behind is along z
+    t = (np.arange(samples) + 0.5) / samples
+    starts = (ring[:, None, :] + t[None, :, None] * edges[:, None, :]).reshape(-1, 2)
+    normal = np.zeros((len(ring), 2))
+    normal[np.arange(len(ring)), axis] = 1.0
+    normal = np.repeat(normal, samples, axis=0)
+    reach = 2.0 * float(max(extent))
+    tol = 1e-6 * reach
+    forward = shapely.contains_xy(poly, *(starts + 10 * tol * normal).T)
+    normal[~forward] *= -1.0  # inward
+    rays = shapely.linestrings(np.stack([starts + tol * normal, starts + reach * normal], axis=1))
+    parts, index = shapely.get_parts(shapely.intersection(rays, poly), return_index=True)
+    first = shapely.distance(parts, shapely.points(starts[index] + tol * normal[index])) < 2 * tol
+    length = np.full(len(starts), np.inf)
+    np.minimum.at(length, index[first], shapely.length(parts[first]) + tol)
+    across = np.repeat(axis, samples)
+    out = []
+    for a in (0, 1):
+        mine = length[(across == a) & np.isfinite(length)]
+        out.append(float(np.clip(mine.min() / extent[a], 0.0, 1.0)) if mine.size else 1.0)
+    return out[0], out[1]
+
+
 def restyle(
     mass: str,
     style: str | Grammar,
@@ -112,8 +162,9 @@ def restyle(
     section: int = 0,
     allow_paths: Iterable[str | os.PathLike] = (),
 ):
-    """The styled mass (a bgr.interpreter.derive.Result) and a one-line report.  ``style`` is the
-    sheet's path, or the sheet loaded once (bgr.load) to style several masses with it."""
+    """The styled mass (a bgr.interpreter.derive.Result) and a one-line report.  ``style`` is
+    the sheet's path or the sheet already loaded (a sheet of many buildings takes seconds to
+    load: put each of its sections on many masses with one load)."""
     from bgr.grammar.loader import load
     from bgr.interpreter.derive import derive
     from bgr.interpreter.lots import footprint
@@ -146,12 +197,15 @@ def restyle(
     scale = capture.scale
     targets = [tuple(v * scale for v in b.size) for b in capture.blocks]
     matched = match_blocks(sources, targets)  # type: ignore[arg-type]
+    if len(targets) == 1 and len(sources) > 1:
+        matched = [STACK]  # both forced matches at once: every source block, stacked
     lots = []
     for j, block in enumerate(capture.blocks):
         ring = _front_first(capture.contours[block.levels[0]])
         points = np.column_stack([ring[:, 0], np.full(len(ring), block.bottom), ring[:, 1]])
         world = frame.unapply(points)
         base = float(world[:, 1].mean())
+        rx, rz = thinnest(ring)
         lots.append(
             footprint(
                 [(float(x), float(z)) for x, _, z in world],
@@ -160,10 +214,12 @@ def restyle(
                     "block": matched[j],
                     "block_base": base,
                     "block_height": (block.top - block.bottom) * scale,
+                    "recess_x": rx,
+                    "recess_z": rz,
                 },
                 name=f"block {j}",
             )
         )
     result = derive(grammar, seed=seed, lot=lots)
-    pairs = ", ".join(f"{j}<-{i}" for j, i in enumerate(matched))
+    pairs = ", ".join(f"{j}<-{'all' if i == STACK else i}" for j, i in enumerate(matched))
     return result, f"{len(lots)} blocks styled by source blocks ({pairs})"

@@ -1,0 +1,148 @@
+"""Equations 8 and 9 (section 5.2.3) as ``.bgr`` rules, written once per number m of insertable
+pieces, the sizes and the pieces being parameters (issue 27; the style sheet is emit.py's):
+
+    SplitX2(a0, a1, a2, b0, b1, p, c1, c2, d0, d1, d2, s0, s1, s2, i0, i1, w) -->
+        SplitX2Fit(.., floor(scope.sx / p))                 x whole patterns of length p
+    SplitX2Fit(.., x) --> SplitX2Y(.., x, (scope.sx - x * p >= c1 ? 1 : 0) + (.. >= c2 ? 1 : 0))
+    SplitX2Y(.., x, y) --> case (a tie, y = 0): .. | case (x = 0, y = 0): SplitX2Scaled(..)
+                         | else: SplitX2Run(a.., b.., s.., i.., w, x, y, Sr)
+    SplitX2Run(.., x, y, sr) --> case (Sr beyond MAX_SR): SplitX2Scaled(..)
+        | case x > 0: split(x) { a0 * sr: Wall(s0) | b0: Bay(w, i0) | ..
+                                 | ~1: SplitX2Run(.., x - 1, y, sr) }
+        | else: split(x) { ~a0: Wall(s0) | (y > 0 ? b0 : 0): Bay(w, i0) | .. }   the tail
+
+(c_y and d_y the sums of b0 .. b(y-1) and a0 .. ay).  A group's rule is one line of its
+numbers (``Bays3(w, s0, s1, i0) --> SplitX1(0.8, 0.8, 1.2, 2.8, 1.2, 0.8, 1.6, s0, s1, i0,
+w)``), and a face one line of its crops per row.  So the text grows with the crops, not with
+faces x pieces x tail cases: PLATEAU's 10 buildings took 22,900 lines (parsing and formatting
+them was most of a capture's time) and take about 4,500, deriving the same meshes (benchmarked
+in bench/style.py, docs/benchmarks.md).
+
+Along x the pieces are crops: ``Wall(s)`` stretched, ``Bay(w, i)`` a window (``w`` = 1) or, in
+a wall band between window rows cut at the same columns, a wall (``w`` = 0).  Along y they are
+the face's rows, rules that call its stack group's rule with their crops.
+
+Two deviations, both for the texture's sake where the equations leave a piece stretched far
+beyond the density it was photographed at (PLATEAU: a crop of 2 pixels over 8 m).  When not one
+insertable fits (x = 0 and y = 0) equation 8 leaves a0 alone stretched over the whole face, and
+when equation 9's Sr is above MAX_SR or below 1 / MAX_SR (a pattern of a 12.45 m "window" and
+0.45 m of wall on a 24 m face: Sr = 12.7) the walls between windows swell or vanish; in both
+cases the face takes the nearest whole number of patterns (at least one), every piece scaled
+alike (``..Scaled``: a floating repeat of a0 b0 .. am), so it shows the source's pieces in their
+order and proportions.  And a rule with no insertable (m = 0) repeats its one scalable piece,
+each about a0 long (MIN_REPEAT at least), rather than stretching it once over the scope.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+from bgr.grammar.formatter import format_number
+
+MIN_PIECE = 0.001  # metres: a scalable piece this short still takes its share (no 0 / 0)
+MAX_SR = 2.0  # walls between windows stretch at most this much (or shrink to 1 / MAX_SR)
+MIN_REPEAT = 0.5  # metres: a repeated plain piece (a rule with no insertable) is at least this
+
+
+def num(x: float, digits: int = 4) -> str:
+    """A .bgr number rounded to ``digits`` decimals (millimetres for metres)."""
+    return format_number(round(float(x), digits) + 0.0)
+
+
+def split_sizes(scalable: Sequence[float], insertable: Sequence[float]) -> list[str]:
+    """The numbers a group hands its Split rule: A (a0 .. am, each at least MIN_PIECE), B (b0 ..
+    b(m-1)), the pattern's length P, the sums c1 .. cm of b0 .. b(y-1) and d0 .. dm of a0 ..
+    ay.  The sums are rounded here, once, like the sizes: summed by the grammar they would
+    carry float error, and a target exactly as wide as a sum (the source's own mass) would
+    fall on either side of an equation 8 comparison."""
+    a = [max(MIN_PIECE, v) for v in scalable]
+    b = list(insertable)
+    sums = [sum(a) + sum(b)] + [sum(b[:y]) for y in range(1, len(b) + 1)]
+    sums += [sum(a[: y + 1]) for y in range(len(a))]
+    return [num(v) for v in a + b + sums]
+
+
+def group_body(
+    axis: str, scalable: Sequence[float], insertable: Sequence[float], args: Sequence[str]
+) -> str:
+    """The successor of a group's rule: its Split rule called with its sizes and ``args`` (s0 ..
+    sm, i0 .. i(m-1), then ``w`` along x); with no insertable piece (m = 0), its one scalable
+    piece repeated (see the module's docstring)."""
+    if insertable:
+        sizes = split_sizes(scalable, insertable)
+        return f"Split{axis.upper()}{len(insertable)}({', '.join(sizes + list(args))})"
+    piece = f"Wall({args[0]})" if axis == "x" else args[0]
+    return f"split({axis}) {{ ~{num(max(scalable[0], MIN_REPEAT))}: {piece} }}*"
+
+
+def split_rules(axis: str, m: int) -> list[str]:
+    """Equations 8-9 (split_h along x, split_v along y) once for every rule of ``m >= 1``
+    insertable pieces: ``SplitX<m>(a0 .. am, b0 .. b(m-1), p, c1 .. cm, d0 .. dm, s0 .. sm,
+    i0 .. i(m-1), w)`` takes the sizes of A (scalable, metres) and B (insertable) and their
+    sums (:func:`split_sizes`), then the pieces (see the module's docstring).
+
+    ``..Fit`` takes x = floor(W / P) whole patterns; ``..Y`` the largest tail y whose insertable
+    pieces b0 .. b(y-1) fit what is left (the count of the sums c_k the rest holds: they grow
+    with k), Sr filling the scope, and a tie in the window count when no tail fits goes to the
+    layout whose walls stretch least; ``..Run`` lays the whole patterns one by one, then the
+    tail [a0 b0 .. a(y-1) b(y-1) ay] as one split whose pieces beyond y have size 0 (a split
+    makes no shape of size 0).  Every choice is one expression rather than a case per y, so the
+    text grows with m, not m^2 (the rules pass every parameter on: a case per y made a rule
+    of 74 windows 70,000 tokens long).  ``..Scaled`` is the deviation of the module's
+    docstring."""
+    a = [f"a{k}" for k in range(m + 1)]
+    b = [f"b{k}" for k in range(m)]
+    c = [f"c{k}" for k in range(1, m + 1)]  # c_y = b0 + .. + b(y-1)
+    d = [f"d{k}" for k in range(m + 1)]  # d_y = a0 + .. + ay
+    s = [f"s{k}" for k in range(m + 1)]
+    i = [f"i{k}" for k in range(m)]
+    flag = ["w"] if axis == "x" else []
+    scalable = [f"Wall({v})" for v in s] if axis == "x" else s
+    inserted = [f"Bay(w, {v})" for v in i] if axis == "x" else i
+    name = f"Split{axis.upper()}{m}"
+    every = ", ".join(a + b + ["p"] + c + d + s + i + flag)
+    pieces = ", ".join(a + b + s + i + flag)  # what laying the pieces out needs
+    size = f"scope.s{axis}"
+    sum_a, sum_b = d[m], c[m - 1]
+    # y: how many of c1 <= c2 <= .. <= cm the rest holds, i.e. the largest y with c_y <= rest
+    y = _balanced([f"({size} - x * p >= {v} ? 1 : 0)" for v in c])
+    tail_b = _balanced([f"(y == {k} ? {v} : 0)" for k, v in enumerate(c, 1)])
+    tail_a = _balanced([f"(y == {k} ? {v} : 0)" for k, v in enumerate(d)])
+    sr = f"({size} - x * {sum_b} - {tail_b}) / (x * {sum_a} + {tail_a})"
+    alt = f"({size} - x * {sum_b}) / (x * {sum_a})"
+    sr0 = f"({size} - x * {sum_b}) / (x * {sum_a} + {d[0]})"
+    whole = [f"{a[0]} * sr: {scalable[0]}"]
+    tail = [f"~{a[0]}: {scalable[0]}"]
+    scaled = [f"~{a[0]}: {scalable[0]}"]
+    for k in range(m):
+        whole += [f"{b[k]}: {inserted[k]}", f"{a[k + 1]} * sr: {scalable[k + 1]}"]
+        tail += [
+            f"(y > {k} ? {b[k]} : 0): {inserted[k]}",
+            f"~(y > {k} ? {a[k + 1]} : 0): {scalable[k + 1]}",
+        ]
+        scaled += [f"~{b[k]}: {inserted[k]}", f"~{a[k + 1]}: {scalable[k + 1]}"]
+    whole.append(f"~1: {name}Run({pieces}, x - 1, y, sr)")
+    fewer = f"{name}Run({pieces}, x - 1, {m}, {alt})"
+    return [
+        f"{name}({every}) --> {name}Fit({every}, floor({size} / p))",
+        f"{name}Fit({every}, x) --> {name}Y({every}, x, {y})",
+        # a tie in the window count (no tail fits): the layout whose walls stretch least;
+        # not one insertable fits: the whole pattern scaled
+        f"{name}Y({every}, x, y) --> "
+        f"case y == 0 and x > 0 and abs({alt} - 1) < abs({sr0} - 1): {fewer} "
+        f"| case y == 0 and x == 0: {name}Scaled({pieces}) "
+        f"| else: {name}Run({pieces}, x, y, {sr})",
+        f"{name}Run({pieces}, x, y, sr) --> "
+        f"case sr > {num(MAX_SR)} or sr < {num(1 / MAX_SR)}: {name}Scaled({pieces}) "
+        f"| case x > 0: split({axis}) {{ {' | '.join(whole)} }} "
+        f"| else: split({axis}) {{ {' | '.join(tail)} }}",
+        f"{name}Scaled({pieces}) --> split({axis}) {{ {' | '.join(scaled)} }}*",
+    ]
+
+
+def _balanced(terms: list[str]) -> str:
+    """A sum of terms nested log2(n) deep: the checker limits an expression's depth."""
+    if len(terms) == 1:
+        return terms[0]
+    half = len(terms) // 2
+    return f"({_balanced(terms[:half])} + {_balanced(terms[half:])})"
