@@ -190,10 +190,15 @@ def averaged(faces: list[Face]) -> np.ndarray | None:
     textures = [f.texture for f in faces if f.texture is not None]
     if not textures:
         return None
+    if len(textures) == 1:  # its own average, at its own size (a group of one: most stacks)
+        return np.array(textures[0], dtype=np.uint8)
     h = int(np.median([t.shape[0] for t in textures]))
     w = int(np.median([t.shape[1] for t in textures]))
     total = np.zeros((h, w, 3))
     for t in textures:
+        if t.shape[:2] == (h, w):  # the resampling below would be the identity
+            total += t
+            continue
         rows = np.minimum((np.arange(h) + 0.5) * t.shape[0] // h, t.shape[0] - 1).astype(int)
         cols = np.minimum((np.arange(w) + 0.5) * t.shape[1] // w, t.shape[1] - 1).astype(int)
         total += t[np.ix_(rows, cols)]  # one gather, not a copy of whole rows first
