@@ -93,28 +93,53 @@ def shape_similarity(lower: Face, upper: Face) -> float:
     return overlap / narrower if narrower > 0 else 0.0
 
 
-def column_signal(face: Face, lo: float, hi: float, span: tuple[float, float]) -> np.ndarray | None:
-    """omega of equation 2: the face's pixel columns averaged (grey, 0..1), sampled at
-    SIGNAL_SAMPLES points of the stretch lo..hi of the axis along which the face covers
-    ``span``; None when untextured."""
+def column_means(face: Face) -> np.ndarray | None:
+    """The face's pixel columns averaged (grey, 0..1), left to right; None when untextured.
+    A mean over the whole texture: ``vertical_links`` computes it once a face, not once for
+    every pair that face is compared in (that was the capture's largest single cost)."""
     if face.texture is None:
         return None
-    grey = face.texture.astype(np.float64).mean(axis=2).mean(axis=0) / 255.0
+    return face.texture.astype(np.float64).mean(axis=2).mean(axis=0) / 255.0
+
+
+def column_signal(
+    face: Face,
+    lo: float,
+    hi: float,
+    span: tuple[float, float],
+    grey: np.ndarray | None = None,
+) -> np.ndarray | None:
+    """omega of equation 2: the face's pixel columns averaged (grey, 0..1), sampled at
+    SIGNAL_SAMPLES points of the stretch lo..hi of the axis along which the face covers
+    ``span``; None when untextured.  ``grey``: the face's ``column_means`` when already known."""
+    if grey is None:
+        grey = column_means(face)
+    if grey is None:
+        return None
     a0, a1 = span
     at = (np.linspace(lo, hi, SIGNAL_SAMPLES) - a0) / max(a1 - a0, 1e-12)
     cols = np.clip((at * len(grey)).astype(np.int64), 0, len(grey) - 1)
     return grey[cols]
 
 
-def texture_similarity(lower: Face, upper: Face) -> float:
+def texture_similarity(
+    lower: Face,
+    upper: Face,
+    means: tuple[np.ndarray | None, np.ndarray | None] | None = None,
+) -> float:
     """Equation 2: the correlation of the two faces' column signals over their overlap.  Two
     untextured faces are alike (1); a textured and an untextured face are not (0); a flat
-    signal correlates with another flat one only."""
+    signal correlates with another flat one only.  ``means``: the two faces' ``column_means``
+    when already known."""
     (a0, a1), (b0, b1) = spans(lower, upper)
     lo, hi = max(a0, b0), min(a1, b1)
-    s, t = column_signal(lower, lo, hi, (a0, a1)), column_signal(upper, lo, hi, (b0, b1))
-    if s is None or t is None:
-        return 1.0 if s is None and t is None else 0.0
+    if means is None:
+        means = (column_means(lower), column_means(upper))
+    if means[0] is None or means[1] is None:
+        return 1.0 if means[0] is None and means[1] is None else 0.0
+    s = column_signal(lower, lo, hi, (a0, a1), means[0])
+    t = column_signal(upper, lo, hi, (b0, b1), means[1])
+    assert s is not None and t is not None
     ds, dt = s - s.mean(), t - t.mean()
     ns, nt = float(np.sqrt(ds @ ds)), float(np.sqrt(dt @ dt))
     if ns < 1e-9 or nt < 1e-9:
@@ -133,6 +158,13 @@ def vertical_links(faces: list[Face]) -> list[int]:
             i = parent[i]
         return i
 
+    means: dict[int, np.ndarray | None] = {}
+
+    def grey(i: int) -> np.ndarray | None:
+        if i not in means:
+            means[i] = column_means(faces[i])
+        return means[i]
+
     by_level: dict[tuple[int, int], list[int]] = {}
     for i, f in enumerate(faces):
         by_level.setdefault((f.wall, f.level), []).append(i)
@@ -140,10 +172,11 @@ def vertical_links(faces: list[Face]) -> list[int]:
         above = by_level.get((f.wall, f.level + 1), [])
         if not above:
             continue
-        best = max(above, key=lambda j: (shape_similarity(f, faces[j]), -j))
-        if (
-            shape_similarity(f, faces[best]) > SHAPE_LINK
-            and texture_similarity(f, faces[best]) > TEXTURE_LINK
+        shapes = [shape_similarity(f, faces[j]) for j in above]
+        k = max(range(len(above)), key=lambda n: (shapes[n], -above[n]))
+        best = above[k]
+        if shapes[k] > SHAPE_LINK and (
+            texture_similarity(f, faces[best], (grey(i), grey(best))) > TEXTURE_LINK
         ):
             parent[root(best)] = root(i)
     roots = [root(i) for i in range(len(faces))]
@@ -157,13 +190,18 @@ def averaged(faces: list[Face]) -> np.ndarray | None:
     textures = [f.texture for f in faces if f.texture is not None]
     if not textures:
         return None
+    if len(textures) == 1:  # its own average, at its own size (a group of one: most stacks)
+        return np.array(textures[0], dtype=np.uint8)
     h = int(np.median([t.shape[0] for t in textures]))
     w = int(np.median([t.shape[1] for t in textures]))
     total = np.zeros((h, w, 3))
     for t in textures:
+        if t.shape[:2] == (h, w):  # the resampling below would be the identity
+            total += t
+            continue
         rows = np.minimum((np.arange(h) + 0.5) * t.shape[0] // h, t.shape[0] - 1).astype(int)
         cols = np.minimum((np.arange(w) + 0.5) * t.shape[1] // w, t.shape[1] - 1).astype(int)
-        total += t[rows][:, cols]
+        total += t[np.ix_(rows, cols)]  # one gather, not a copy of whole rows first
     return (total / len(textures)).astype(np.uint8)
 
 

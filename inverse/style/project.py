@@ -219,13 +219,16 @@ def _project_face(
     uv, covered = _raster(proj, tris.uv[index], np.argsort(front, kind="stable"), face, cols, rows)
     wrap = images.mesh.materials[winner].wrap
     texture = np.empty((rows, cols, 3), dtype=np.float32)
-    texture[covered] = _bilinear(image, wrapped(uv[covered], wrap))
-    if covered.any():
+    if covered.all():  # the usual case: no mask to gather through or scatter back
+        texture.reshape(-1, 3)[:] = _bilinear(image, wrapped(uv.reshape(-1, 2), wrap))
+    elif covered.any():
+        texture[covered] = _bilinear(image, wrapped(uv[covered], wrap))
         texture[~covered] = texture[covered].mean(axis=0)
     else:  # a grid too coarse for any pixel centre to fall in: the triangles' mean colour
         centres = wrapped(tris.uv[index].mean(axis=1), wrap)
         texture[:] = _bilinear(image, centres).mean(axis=0)
-    face.texture = np.clip(np.rint(texture), 0, 255).astype(np.uint8)
+    np.rint(texture, out=texture)
+    face.texture = np.clip(texture, 0, 255, out=texture).astype(np.uint8)
     face.color = _rgb(face.texture.reshape(-1, 3).mean(axis=0))
 
 
@@ -305,14 +308,21 @@ def _raster(
             continue
         x = np.arange(j0, j1) + 0.5
         y = np.arange(i0, i1)[:, None] + 0.5
-        w1 = ((x - a[0]) * (c[1] - a[1]) - (c[0] - a[0]) * (y - a[1])) / det
-        w2 = ((b[0] - a[0]) * (y - a[1]) - (x - a[0]) * (b[1] - a[1])) / det
-        w0 = 1.0 - w1 - w2
+        # the same arithmetic as ((x - a0) * (c1 - a1) - (c0 - a0) * (y - a1)) / det, each
+        # factor on a row or a column and only the last two steps on the whole box, in place
+        w1 = np.subtract((x - a[0]) * (c[1] - a[1]), (c[0] - a[0]) * (y - a[1]))
+        w1 /= det
+        w2 = np.subtract((b[0] - a[0]) * (y - a[1]), (x - a[0]) * (b[1] - a[1]))
+        w2 /= det
+        w0 = np.subtract(1.0, w1)
+        w0 -= w2
         eps = -1e-9  # a pixel centre on an edge two triangles share belongs to both
-        inside = (w0 >= eps) & (w1 >= eps) & (w2 >= eps)
+        inside = w0 >= eps
+        inside &= w1 >= eps
+        inside &= w2 >= eps
         if not inside.any():
             continue
-        bary = np.stack([w0, w1, w2], axis=-1)[inside]  # (p, 3)
+        bary = np.stack([w0[inside], w1[inside], w2[inside]], axis=-1)  # (p, 3)
         block = out[i0:i1, j0:j1]
         block[inside] = bary @ uv[t]
         covered[i0:i1, j0:j1] |= inside
@@ -329,8 +339,11 @@ def _bilinear(image: np.ndarray, uv: np.ndarray) -> np.ndarray:
     x0, y0 = np.floor(x).astype(np.int64), np.floor(y).astype(np.int64)
     x1, y1 = np.minimum(x0 + 1, cols - 1), np.minimum(y0 + 1, rows - 1)
     fx, fy = (x - x0)[:, None], (y - y0)[:, None]
-    top = image[y0, x0] * (1 - fx) + image[y0, x1] * fx
-    bottom = image[y1, x0] * (1 - fx) + image[y1, x1] * fx
+    flat = image.reshape(rows * cols, image.shape[2])  # one row-major index a texel: np.take
+    r0, r1 = y0 * cols, y1 * cols  # gathers whole texels faster than image[y, x] does
+    gx = 1 - fx
+    top = np.take(flat, r0 + x0, axis=0) * gx + np.take(flat, r0 + x1, axis=0) * fx
+    bottom = np.take(flat, r1 + x0, axis=0) * gx + np.take(flat, r1 + x1, axis=0) * fx
     return top * (1 - fy) + bottom * fy
 
 
