@@ -81,7 +81,7 @@ def test_an_unknown_building_is_refused(models: Path, capsys) -> None:
     model = _obj(models, "box", "brick")
     args = ["infer", str(model), "--kind", "style", "--building", "nope", "-o", str(out)]
     assert main(args) == 1
-    assert "no object of that id" in capsys.readouterr().err
+    assert "no building 'nope' in the model" in capsys.readouterr().err
     assert not out.exists()
 
 

@@ -20,7 +20,7 @@ from .emit import Crops, style_text
 from .groups import Groups, face_groups
 from .model import Capture
 from .project import face_textures, roof_color
-from .remesh import capture_geometry
+from .remesh import capture_geometry, selection
 
 READERS = {
     ".gml": "citygml",
@@ -77,18 +77,7 @@ def building_ids(mesh: TexturedMesh, building: str | None) -> list[str | None]:
             )
         )
     if building is not None:
-        if building not in mesh.object_ids:
-            shown = ", ".join(mesh.object_ids[:5]) + (" ..." if len(mesh.object_ids) > 5 else "")
-            raise BgrError(
-                Diagnostic(
-                    mesh.source,
-                    0,
-                    0,
-                    f"--building {building}: the model has no object of that id",
-                    f"its objects are {shown}",
-                )
-            )
-        if not textured[mesh.mask(object_id=building)].any():
+        if not textured[selection(mesh, building)].any():  # an unknown id: a located error
             raise BgrError(
                 Diagnostic(
                     mesh.source,

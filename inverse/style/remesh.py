@@ -380,7 +380,7 @@ def walls(block: Block, contours: list[np.ndarray], floors: np.ndarray) -> None:
                 block.walls[w].append(Face(w, level, b.copy(), a.copy(), bottom, top))
 
 
-def _selection(mesh: TexturedMesh, building: str | None) -> np.ndarray:
+def selection(mesh: TexturedMesh, building: str | None) -> np.ndarray:
     """(F,) bool: the building's triangles (all of them for None).  A CityGML reader already
     gives each building its highest level of detail, with every semantic surface (walls, roofs,
     ground) of it: all of them are the building's shape."""
@@ -411,7 +411,7 @@ def capture_geometry(mesh: TexturedMesh, building: str | None) -> tuple[Capture,
     ``mesh.object_ids``; None: the whole mesh): its standard view, floors, outlines, blocks and
     walls.  Faces carry no texture yet.  Raises :class:`BgrError` located at ``mesh.source`` for
     an unknown building, an empty selection, no vertical faces or zero height."""
-    keep = _selection(mesh, building)
+    keep = selection(mesh, building)
     frame = standard_frame(mesh, keep)
     tris = mesh.faces[keep]
     used, local = np.unique(tris, return_inverse=True)
