@@ -267,8 +267,15 @@ def test_cli_bad_inputs_exit_1_with_the_element_named(tmp_path, capsys, content,
 
 
 def test_cli_other_kinds_say_they_are_not_written(capsys):
+    assert main(["infer", str(DATA / "palazzo.bgr"), "--kind", "image"]) == 1
+    assert "--kind image is not written yet" in capsys.readouterr().err
+
+
+def test_cli_kind_style_refuses_a_grammar_saying_what_it_reads(capsys):
     assert main(["infer", str(DATA / "palazzo.bgr"), "--kind", "style"]) == 1
-    assert "not written yet" in capsys.readouterr().err
+    err = capsys.readouterr().err
+    assert "palazzo.bgr: error: bgr infer --kind style reads a textured model" in err
+    assert "hint:" in err
 
 
 # ---- fuzz: no input gives a traceback ----------------------------------------------------------
