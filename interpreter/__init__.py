@@ -1,1 +1,1 @@
-"""Derivation of .bgr grammars into meshes (issue 3; not written yet)."""
+"""Derivation of .bgr grammars into meshes: the engine, its operations and geometry (issue 3)."""

@@ -1,5 +1,6 @@
 """Inverse modules that write .bgr grammars from data: Build-by-Number face schemas (schema/,
-``bgr infer --kind schema``), city-scale proceduralization (city/, ``--kind city``) and
+``bgr infer --kind schema``), city-scale proceduralization (city/, ``--kind city``),
 structure-preserving retargeting of box hierarchies (boxes/, ``bgr retarget`` and
-``--kind boxes``). Style sheets and photographs (``--kind style``, ``--kind image``) are not
-written yet."""
+``--kind boxes``) and style sheets of textured buildings (style/, ``--kind style`` and
+``bgr restyle``). A procedural building from a photograph (``--kind image``) is not written
+yet."""
