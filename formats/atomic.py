@@ -17,6 +17,7 @@ from __future__ import annotations
 import contextlib
 import os
 import secrets
+import signal
 import time
 from collections.abc import Iterator
 from pathlib import Path
@@ -72,6 +73,22 @@ def _open_temp(target: Path) -> tuple[Path, BinaryIO]:
             continue
         return tmp, os.fdopen(fd, "wb")
     raise FileExistsError(f"no free temporary name in {folder}")
+
+
+@contextlib.contextmanager
+def _signals_held() -> Iterator[None]:
+    """Hold SIGTERM and SIGINT while a temporary is created and recorded: a signal that landed
+    between ``os.open`` and the record would unwind past a file nobody knows to remove.  The
+    held signal is delivered when the block ends, with the temporary on the list."""
+    mask = getattr(signal, "pthread_sigmask", None)
+    if mask is None:  # Windows: no signal masks
+        yield
+        return
+    previous = mask(signal.SIG_BLOCK, {signal.SIGTERM, signal.SIGINT})
+    try:
+        yield
+    finally:
+        mask(signal.SIG_SETMASK, previous)
 
 
 def _alive(pid: int) -> bool:
@@ -156,7 +173,8 @@ def atomic_files(targets: list[Path]) -> Iterator[list[BinaryIO]]:
                 raise IsADirectoryError(21, "it is a folder", str(target))
             check_output(target)
             remove_stale(target)
-            temps.append(_open_temp(target))
+            with _signals_held():
+                temps.append(_open_temp(target))
         current = targets[0]
         yield [f for _, f in temps]
         raise_if_terminated()
