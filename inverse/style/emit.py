@@ -155,6 +155,29 @@ def _block_rule(head: str, entries: list[str], repeat: str = "") -> _Raw:
     return _Raw("\n".join(rows + ["}" + repeat]))
 
 
+def _negated(depth: str) -> str:
+    """``-(depth)`` as bgr fmt prints it, for the three forms a recess takes: ``0``, a product
+    ``a * min(1, k)`` (which keeps its parentheses) and a call ``min(..)`` (which needs none).
+    A difference ``a - b`` of two of them needs no parentheses either."""
+    if depth == "0":
+        return "0"
+    return f"-{depth}" if depth.startswith("min(") else f"-({depth})"
+
+
+def _case_rule(head: str, alts: list[str]) -> str:
+    """``head alt1 | alt2 ..`` (``case c: steps`` / ``else: steps``, steps without a block) in
+    the formatter's layout: one line when it fits, else the head alone and one alternative a
+    line, each after the first behind ``| ``.  A head too long for HEAD_WIDTH, which the
+    formatter breaks one parameter a line, is left to the formatter."""
+    if len(head) > HEAD_WIDTH:
+        return f"{head} {' | '.join(alts)}"
+    line = f"{head} {' | '.join(alts)}"
+    if len(line) <= WIDTH:
+        return _Raw(line)
+    rows = [head, f"{INDENT}{alts[0]}"] + [f"{INDENT}| {a}" for a in alts[1:]]
+    return _Raw("\n".join(rows))
+
+
 class _Sheet:
     """Writes one building's section; ``p`` prefixes its rule names."""
 
@@ -290,17 +313,16 @@ class _Sheet:
                     if 0 <= n < len(on) and depths[n][0] < depth - RECESS:
                         near = depths[n][1]
                         parts.append(
-                            f"[ t(0, 0, -({near})) {self.p}Jamb{side}(({d}) - ({near}), {colour}) ]"
+                            f"[ t(0, 0, {_negated(near)}) "
+                            f"{self.p}Jamb{side}({d} - {near}, {colour}) ]"
                         )
-                pieces.append(f"~{num(span * metres)}: {' '.join(parts)} t(0, 0, -({d})) {rule}")
+                pieces.append(
+                    f"~{num(span * metres)}: {' '.join(parts)} t(0, 0, {_negated(d)}) {rule}"
+                )
             if not pieces:
                 pieces = ["~1: Plain"]
             lname = f"{name}L{level}"
-            head = f"{lname}(k) --> split(x)"
-            if any(d for d, _ in depths):  # its expressions as bgr fmt prints them
-                self.lines.append(f"{head} {{ {' | '.join(pieces)} }}")
-            else:
-                self.lines.append(_block_rule(head, pieces))
+            self.lines.append(_block_rule(f"{lname}(k) --> split(x)", pieces))
             span = (self.capture.floors[level + 1] - self.capture.floors[level]) * metres
             levels.append(f"~{num(span)}: {lname}(k)")
         self.lines.append(_block_rule(f"{name}(k) --> split(y)", levels))
@@ -361,7 +383,7 @@ class _Sheet:
                 cases.append(f"case scope.sx < {num(limit)} * full: {part}")
             else:
                 cases.append(f"else: {part}")
-        self.lines.append(f"{wall}Side(full, k) --> " + " | ".join(cases))
+        self.lines.append(_case_rule(f"{wall}Side(full, k) -->", cases))
         return f"{wall}Side({('bw', 'bd')[w % 2]}, {k})"
 
     def building(self) -> None:
@@ -506,14 +528,14 @@ def style_text(sheets: list[tuple[Capture, Groups]], crops: Crops) -> str:
             for j in range(len(capture.blocks))
         ]
         blocks.append(f"case block == -2: t(0, block_base, 0) extrude(block_height) {p}Stack")
-        starts.append((p, " | ".join(blocks) + f" | else: extrude(height) {p}Building"))
+        starts.append((p, blocks + [f"else: extrude(height) {p}Building"]))
     if len(starts) == 1:
-        out.append(f"Lot --> {starts[0][1]}")
+        out.append(_case_rule("Lot -->", starts[0][1]))
     else:
         cases = [f"case style == {k}: {p}Lot" for k, (p, _) in enumerate(starts[:-1])]
-        out.append("Lot --> " + " | ".join(cases) + f" | else: {starts[-1][0]}Lot")
+        out.append(_case_rule("Lot -->", cases + [f"else: {starts[-1][0]}Lot"]))
         for p, body in starts:
-            out.append(f"{p}Lot --> {body}")
+            out.append(_case_rule(f"{p}Lot -->", body))
     out.append(
         "# a crop of a face's texture stretched once over the piece, in its own colours (a "
         "shape's colour multiplies its texture, and bgr's default is a light grey)"

@@ -338,7 +338,10 @@ def _bilinear(image: np.ndarray, uv: np.ndarray) -> np.ndarray:
     y = np.clip((1.0 - uv[:, 1]) * rows - 0.5, 0.0, rows - 1.0)
     x0, y0 = np.floor(x).astype(np.int64), np.floor(y).astype(np.int64)
     x1, y1 = np.minimum(x0 + 1, cols - 1), np.minimum(y0 + 1, rows - 1)
-    fx, fy = (x - x0)[:, None], (y - y0)[:, None]
+    # the weights in the image's float32: a texel's colour needs no more, and the products of
+    # a million-pixel face move half the bytes
+    fx = (x - x0).astype(image.dtype)[:, None]
+    fy = (y - y0).astype(image.dtype)[:, None]
     flat = image.reshape(rows * cols, image.shape[2])  # one row-major index a texel: np.take
     r0, r1 = y0 * cols, y1 * cols  # gathers whole texels faster than image[y, x] does
     gx = 1 - fx
