@@ -114,10 +114,42 @@ def test_a_face_narrower_than_a_window_takes_the_pattern_scaled():
     assert _windows(band, 1.5).shape == (0, 2)
 
 
-def test_the_sheet_is_what_bgr_fmt_prints(tmp_path):
+@pytest.mark.parametrize("kind", range(5))
+def test_the_sheet_is_what_bgr_fmt_prints(tmp_path, kind):
     """Most of the sheet is written in the formatter's layout without it (emit._Raw): the
-    formatter must leave the whole text unchanged."""
-    glb, _ = make_building(1, tmp_path)
-    text, files, _ = infer_style(str(glb), assets="k1.assets")
+    formatter must leave the whole text unchanged, on every synthetic building (recessed
+    levels, set-backs, L outlines, window rows)."""
+    glb, _ = make_building(kind, tmp_path)
+    text, files, _ = infer_style(str(glb), assets=f"k{kind}.assets")
     assert format_source(text) == text
     assert len(files) > 10
+
+
+@pytest.mark.parametrize("axis", ["x", "y"])
+def test_split_rules_are_built_as_trees_bgr_fmt_prints(axis):
+    """The Split rules are syntax trees printed by the formatter, not parsed text: what they
+    print parses back to the same trees and is what bgr fmt prints, for rules of 1 to 80
+    windows (PLATEAU's and the tessellated model's reach 74)."""
+    from bgr.grammar.parser import parse
+    from bgr.inverse.style.emit_splits import split_rule_nodes
+
+    for m in (*range(1, 12), 37, 74, 80):
+        text = "\n".join(split_rules(axis, m)) + "\n"
+        assert format_source(text) == text, m
+        parsed = parse(text).rules()
+        built = split_rule_nodes(axis, m)
+        assert [(r.name, r.params) for r in parsed] == [(r.name, r.params) for r in built]
+        assert [_shape(r.body) for r in parsed] == [_shape(r.body) for r in built], m
+
+
+def _shape(node):
+    """A node without its source positions, for comparing a parsed tree with a built one."""
+    import dataclasses
+
+    if isinstance(node, list):
+        return [_shape(v) for v in node]
+    if dataclasses.is_dataclass(node):
+        return (type(node).__name__,) + tuple(
+            _shape(getattr(node, f.name)) for f in dataclasses.fields(node) if f.name != "pos"
+        )
+    return node

@@ -82,6 +82,7 @@ def test_all_ten_buildings_capture_and_restyle_the_three_masses(
     """One sheet of the whole file (a section a building), each section on each mass: 30 styled
     models.  The sheet is loaded once (a 10-building sheet takes seconds to load); bgr restyle
     --section is the same call, checked once by the command line."""
+    from bgr.grammar.formatter import format_source
     from bgr.grammar.loader import load
     from bgr.inverse.style.capture import infer_style
     from bgr.inverse.style.restyle import restyle
@@ -91,6 +92,7 @@ def test_all_ten_buildings_capture_and_restyle_the_three_masses(
     sheet = tmp_path / "plateau.bgr"
     assert main(["infer", str(PLATEAU), "--kind", "style", "-o", str(sheet)]) == 0
     text = sheet.read_text(encoding="utf-8")
+    assert format_source(text) == text  # written mostly without the formatter, in its layout
     assert [
         line.split()[2].rstrip(":") for line in text.splitlines() if line.startswith("# ---- ")
     ] == ids

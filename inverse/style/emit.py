@@ -205,9 +205,13 @@ class _Sheet:
         if m:
             self.splits.add((axis, m))
         flag = ["w"] if axis == "x" else []
-        head = f"{name}({', '.join(flag + args)})"
-        line = f"{head} --> {group_body(axis, rule.scalable, rule.insertable, args + flag)}"
-        self.shared.append(_Raw(line) if len(head + " -->") <= HEAD_WIDTH else line)
+        params = flag + args
+        head = f"{name}({', '.join(params)}) -->"
+        if len(head) > HEAD_WIDTH:  # bgr fmt's layout: one parameter a line
+            head = "\n".join([f"{name}("] + [f"{INDENT}{v}," for v in params[:-1]])
+            head += f"\n{INDENT}{params[-1]}\n) -->"
+        body = group_body(axis, rule.scalable, rule.insertable, args + flag)
+        self.shared.append(_Raw(f"{head} {body}"))
         return name
 
     def face(self, face: Face) -> str:
@@ -554,7 +558,7 @@ def style_text(sheets: list[tuple[Capture, Groups]], crops: Crops) -> str:
         "# equations 8 and 9: a group's sizes, then its pieces' crops (along y: the face's rows)"
     )
     for axis, m in sorted(splits):
-        out += split_rules(axis, m)
+        out += [_Raw(rule) for rule in split_rules(axis, m)]  # printed by the formatter
     for k, lines in enumerate(sections):
         capture = sheets[k][0]
         out.append(_Raw(""))

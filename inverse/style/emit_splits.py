@@ -37,7 +37,8 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 
-from bgr.grammar.formatter import format_number
+from bgr.grammar import nodes as n
+from bgr.grammar.formatter import format_module, format_number
 
 MIN_PIECE = 0.001  # metres: a scalable piece this short still takes its share (no 0 / 0)
 MAX_SR = 2.0  # walls between windows stretch at most this much (or shrink to 1 / MAX_SR)
@@ -90,59 +91,138 @@ def split_rules(axis: str, m: int) -> list[str]:
     text grows with m, not m^2 (the rules pass every parameter on: a case per y made a rule
     of 74 windows 70,000 tokens long).  ``..Scaled`` is the deviation of the module's
     docstring."""
-    a = [f"a{k}" for k in range(m + 1)]
-    b = [f"b{k}" for k in range(m)]
-    c = [f"c{k}" for k in range(1, m + 1)]  # c_y = b0 + .. + b(y-1)
-    d = [f"d{k}" for k in range(m + 1)]  # d_y = a0 + .. + ay
-    s = [f"s{k}" for k in range(m + 1)]
-    i = [f"i{k}" for k in range(m)]
-    flag = ["w"] if axis == "x" else []
-    scalable = [f"Wall({v})" for v in s] if axis == "x" else s
-    inserted = [f"Bay(w, {v})" for v in i] if axis == "x" else i
-    name = f"Split{axis.upper()}{m}"
-    every = ", ".join(a + b + ["p"] + c + d + s + i + flag)
-    pieces = ", ".join(a + b + s + i + flag)  # what laying the pieces out needs
-    size = f"scope.s{axis}"
-    sum_a, sum_b = d[m], c[m - 1]
-    # y: how many of c1 <= c2 <= .. <= cm the rest holds, i.e. the largest y with c_y <= rest
-    y = _balanced([f"({size} - x * p >= {v} ? 1 : 0)" for v in c])
-    tail_b = _balanced([f"(y == {k} ? {v} : 0)" for k, v in enumerate(c, 1)])
-    tail_a = _balanced([f"(y == {k} ? {v} : 0)" for k, v in enumerate(d)])
-    sr = f"({size} - x * {sum_b} - {tail_b}) / (x * {sum_a} + {tail_a})"
-    alt = f"({size} - x * {sum_b}) / (x * {sum_a})"
-    sr0 = f"({size} - x * {sum_b}) / (x * {sum_a} + {d[0]})"
-    whole = [f"{a[0]} * sr: {scalable[0]}"]
-    tail = [f"~{a[0]}: {scalable[0]}"]
-    scaled = [f"~{a[0]}: {scalable[0]}"]
-    for k in range(m):
-        whole += [f"{b[k]}: {inserted[k]}", f"{a[k + 1]} * sr: {scalable[k + 1]}"]
-        tail += [
-            f"(y > {k} ? {b[k]} : 0): {inserted[k]}",
-            f"~(y > {k} ? {a[k + 1]} : 0): {scalable[k + 1]}",
-        ]
-        scaled += [f"~{b[k]}: {inserted[k]}", f"~{a[k + 1]}: {scalable[k + 1]}"]
-    whole.append(f"~1: {name}Run({pieces}, x - 1, y, sr)")
-    fewer = f"{name}Run({pieces}, x - 1, {m}, {alt})"
-    return [
-        f"{name}({every}) --> {name}Fit({every}, floor({size} / p))",
-        f"{name}Fit({every}, x) --> {name}Y({every}, x, {y})",
-        # a tie in the window count (no tail fits): the layout whose walls stretch least;
-        # not one insertable fits: the whole pattern scaled
-        f"{name}Y({every}, x, y) --> "
-        f"case y == 0 and x > 0 and abs({alt} - 1) < abs({sr0} - 1): {fewer} "
-        f"| case y == 0 and x == 0: {name}Scaled({pieces}) "
-        f"| else: {name}Run({pieces}, x, y, {sr})",
-        f"{name}Run({pieces}, x, y, sr) --> "
-        f"case sr > {num(MAX_SR)} or sr < {num(1 / MAX_SR)}: {name}Scaled({pieces}) "
-        f"| case x > 0: split({axis}) {{ {' | '.join(whole)} }} "
-        f"| else: split({axis}) {{ {' | '.join(tail)} }}",
-        f"{name}Scaled({pieces}) --> split({axis}) {{ {' | '.join(scaled)} }}*",
-    ]
+    return [format_module(n.Module([rule])).rstrip("\n") for rule in split_rule_nodes(axis, m)]
 
 
-def _balanced(terms: list[str]) -> str:
+# The rules are built as syntax trees and printed by the formatter: parsing their text back
+# (about 9,000 tokens for a rule of 70 windows) was a third of a capture's time.
+def _v(name: str) -> n.Name:
+    return n.Name(name)
+
+
+def _k(value: float) -> n.Number:
+    return n.Number(float(value))
+
+
+def _op(op: str, left: n.Expr, right: n.Expr) -> n.Binary:
+    return n.Binary(op, left, right)
+
+
+def _if(cond: n.Expr, then: n.Expr, otherwise: n.Expr) -> n.Ternary:
+    return n.Ternary(cond, then, otherwise)
+
+
+def _call(name: str, *args: n.Expr) -> n.Sequence:
+    """A body of one successor ``name(args)``."""
+    return n.Sequence([n.Successor(name, list(args))])
+
+
+def _split(axis: str, entries: list[tuple[str, n.Expr, n.Sequence]], repeat: bool = False):
+    """A body ``split(axis) { key: body | .. }``, each entry (kind, key, body)."""
+    block = n.Block([n.Entry(kind, key, body) for kind, key, body in entries], repeat)
+    return n.Sequence([n.Operation("split", [_v(axis)], block=block)])
+
+
+def _sum(terms: list[n.Expr]) -> n.Expr:
     """A sum of terms nested log2(n) deep: the checker limits an expression's depth."""
     if len(terms) == 1:
         return terms[0]
     half = len(terms) // 2
-    return f"({_balanced(terms[:half])} + {_balanced(terms[half:])})"
+    return _op("+", _sum(terms[:half]), _sum(terms[half:]))
+
+
+def split_rule_nodes(axis: str, m: int) -> list[n.Rule]:
+    """The five rules of :func:`split_rules` as syntax trees."""
+    a = [_v(f"a{k}") for k in range(m + 1)]
+    b = [_v(f"b{k}") for k in range(m)]
+    c = [_v(f"c{k}") for k in range(1, m + 1)]  # c_y = b0 + .. + b(y-1)
+    d = [_v(f"d{k}") for k in range(m + 1)]  # d_y = a0 + .. + ay
+    s = [_v(f"s{k}") for k in range(m + 1)]
+    i = [_v(f"i{k}") for k in range(m)]
+    flag = [_v("w")] if axis == "x" else []
+    x, y, p, sr_ = _v("x"), _v("y"), _v("p"), _v("sr")
+    zero, one = _k(0), _k(1)
+
+    def scalable(k: int) -> n.Sequence:
+        return _call("Wall", s[k]) if axis == "x" else n.Sequence([n.Successor(s[k].name)])
+
+    def inserted(k: int) -> n.Sequence:
+        return _call("Bay", _v("w"), i[k]) if axis == "x" else n.Sequence([n.Successor(i[k].name)])
+
+    name = f"Split{axis.upper()}{m}"
+    every = a + b + [p] + c + d + s + i + flag
+    pieces = a + b + s + i + flag  # what laying the pieces out needs
+    names = [v.name for v in every]
+    size = _v(f"scope.s{axis}")
+    sum_a, sum_b = d[m], c[m - 1]
+    rest = _op("-", size, _op("*", x, p))
+    # y: how many of c1 <= c2 <= .. <= cm the rest holds, i.e. the largest y with c_y <= rest
+    count = _sum([_if(_op(">=", rest, v), one, zero) for v in c])
+    tail_b = _sum([_if(_op("==", y, _k(k)), v, zero) for k, v in enumerate(c, 1)])
+    tail_a = _sum([_if(_op("==", y, _k(k)), v, zero) for k, v in enumerate(d)])
+    left = _op("-", size, _op("*", x, sum_b))
+    sr = _op("/", _op("-", left, tail_b), _op("+", _op("*", x, sum_a), tail_a))
+    alt = _op("/", left, _op("*", x, sum_a))
+    sr0 = _op("/", left, _op("+", _op("*", x, sum_a), d[0]))
+    whole = [("abs", _op("*", a[0], sr_), scalable(0))]
+    tail = [("float", a[0], scalable(0))]
+    scaled = [("float", a[0], scalable(0))]
+    for k in range(m):
+        whole += [("abs", b[k], inserted(k)), ("abs", _op("*", a[k + 1], sr_), scalable(k + 1))]
+        tail += [
+            ("abs", _if(_op(">", y, _k(k)), b[k], zero), inserted(k)),
+            ("float", _if(_op(">", y, _k(k)), a[k + 1], zero), scalable(k + 1)),
+        ]
+        scaled += [("float", b[k], inserted(k)), ("float", a[k + 1], scalable(k + 1))]
+    whole.append(("float", one, _call(f"{name}Run", *pieces, _op("-", x, one), y, sr_)))
+
+    def distance(e: n.Expr) -> n.Call:  # |e - 1|
+        return n.Call("abs", [_op("-", e, one)])
+
+    def case(cond: n.Expr | None, body: n.Sequence) -> n.Case:
+        return n.Case(cond, body)
+
+    run = [v.name for v in pieces] + ["x", "y", "sr"]
+    rules = [
+        n.Rule(name, names, _call(f"{name}Fit", *every, n.Call("floor", [_op("/", size, p)]))),
+        n.Rule(f"{name}Fit", names + ["x"], _call(f"{name}Y", *every, x, count)),
+        # a tie in the window count (no tail fits): the layout whose walls stretch least;
+        # not one insertable fits: the whole pattern scaled
+        n.Rule(
+            f"{name}Y",
+            names + ["x", "y"],
+            n.Conditional(
+                [
+                    case(
+                        _op(
+                            "and",
+                            _op("and", _op("==", y, zero), _op(">", x, zero)),
+                            _op("<", distance(alt), distance(sr0)),
+                        ),
+                        _call(f"{name}Run", *pieces, _op("-", x, one), _k(m), alt),
+                    ),
+                    case(
+                        _op("and", _op("==", y, zero), _op("==", x, zero)),
+                        _call(f"{name}Scaled", *pieces),
+                    ),
+                    case(None, _call(f"{name}Run", *pieces, x, y, sr)),
+                ]
+            ),
+        ),
+        n.Rule(
+            f"{name}Run",
+            run,
+            n.Conditional(
+                [
+                    case(
+                        _op("or", _op(">", sr_, _k(MAX_SR)), _op("<", sr_, _k(1 / MAX_SR))),
+                        _call(f"{name}Scaled", *pieces),
+                    ),
+                    case(_op(">", x, zero), _split(axis, whole)),
+                    case(None, _split(axis, tail)),
+                ]
+            ),
+        ),
+        n.Rule(f"{name}Scaled", [v.name for v in pieces], _split(axis, scaled, repeat=True)),
+    ]
+    return rules
