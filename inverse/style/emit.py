@@ -153,6 +153,14 @@ def _block_rule(head: str, entries: list[str], repeat: str = "") -> _Raw:
     return _Raw("\n".join(rows + ["}" + repeat]))
 
 
+def _short(line: str) -> str:
+    """A rule of one line whose head is short and whose expressions are written as bgr fmt
+    prints them: kept as it is when it fits the width (the formatter would not break it), else
+    left to the formatter."""
+    head = line.split(" --> ", 1)[0] + " -->"
+    return _Raw(line) if len(line) <= WIDTH and len(head) <= HEAD_WIDTH else line
+
+
 def _negated(depth: str) -> str:
     """``-(depth)`` as bgr fmt prints it, for the three forms a recess takes: ``0``, a product
     ``a * min(1, k)`` (which keeps its parentheses) and a call ``min(..)`` (which needs none).
@@ -411,8 +419,10 @@ class _Sheet:
             fx, fz = (xmin - x0) / (x1 - x0), (zmin - z0) / (z1 - z0)
             sx, sz = (xmax - xmin) / (x1 - x0), (zmax - zmin) / (z1 - z0)
             self.lines.append(
-                f"{p}Block{k} --> t('{num(fx)}, 0, '{num(fz)}) "
-                f"s('{num(sx)}, '1, '{num(sz)}) {p}Block{k}Mass"
+                _short(
+                    f"{p}Block{k} --> t('{num(fx)}, 0, '{num(fz)}) "
+                    f"s('{num(sx)}, '1, '{num(sz)}) {p}Block{k}Mass"
+                )
             )
             floor = f"{p}Roof" if k == 0 else "NIL"  # the ground closes the notches at its foot
             walls += [f"top: {p}Roof", f"bottom: {floor}"]
@@ -425,29 +435,35 @@ class _Sheet:
             params = ["kx", "kz"]
             if any("Side(" in w for w in walls):
                 ks, params = ks + ["scope.sx", "scope.sz"], params + ["bw", "bd"]
-            self.lines.append(f"{p}Block{k}Mass --> {p}Block{k}Walls({', '.join(ks)})")
+            self.lines.append(_short(f"{p}Block{k}Mass --> {p}Block{k}Walls({', '.join(ks)})"))
             head = f"{p}Block{k}Walls({', '.join(params)}) --> comp(f)"
             self.lines.append(_block_rule(head, walls))
             parts.append(f"~{num((block.top - block.bottom) * cap.scale)}: {p}Block{k}")
             for what, size in zip(("width", "height", "depth"), block.size, strict=True):
                 self.consts.append(_Raw(f"const {p}block{k}_{what} = {num(size * cap.scale)}"))
         self.lines.append(_block_rule(f"{p}Building --> split(y)", parts))
-        self.lines.append(f"{p}Stack --> {self.stack()}")
+        self.lines.append(_short(f"{p}Stack --> {self.stack()}"))
         self.lines.append(
-            f"{p}Reveal(d, t, b, c) --> extrude(-d) comp(f) {{ front: {p}RevealSide(t, c) "
-            f"| back: {p}RevealSide(b, c) | all: NIL }}"
+            _short(
+                f"{p}Reveal(d, t, b, c) --> extrude(-d) comp(f) {{ front: {p}RevealSide(t, c) "
+                f"| back: {p}RevealSide(b, c) | all: NIL }}"
+            )
         )
         for side, which in (("L", "left"), ("R", "right")):
             self.lines.append(
-                f"{p}Jamb{side}(d, c) --> extrude(-max(d, 0)) comp(f) {{ {which}: "
-                f"{p}RevealSide(1, c) | all: NIL }}"
+                _short(
+                    f"{p}Jamb{side}(d, c) --> extrude(-max(d, 0)) comp(f) {{ {which}: "
+                    f"{p}RevealSide(1, c) | all: NIL }}"
+                )
             )
         self.lines.append(  # in the recessed face's mean colour, which its sides continue
-            f"{p}RevealSide(keep, c) --> case keep == 1: reverseNormals() color(c) Plain "
-            "| else: NIL"
+            _case_rule(
+                f"{p}RevealSide(keep, c) -->",
+                ["case keep == 1: reverseNormals() color(c) Plain", "else: NIL"],
+            )
         )
         roof = _hex(cap.roof) if cap.roof is not None else ROOF
-        self.lines.append(f'{p}Roof --> color("{roof}") Plain')
+        self.lines.append(_Raw(f'{p}Roof --> color("{roof}") Plain'))
 
 
 def side_columns(block: Block, w: int) -> list[tuple[Face, list[Face | None]]]:
