@@ -84,6 +84,7 @@ def test_all_ten_buildings_capture_and_restyle_the_three_masses(
     --section is the same call, checked once by the command line."""
     from bgr.grammar.formatter import format_source
     from bgr.grammar.loader import load
+    from bgr.interpreter.derive import derive
     from bgr.inverse.style.capture import infer_style
     from bgr.inverse.style.restyle import restyle
 
@@ -102,6 +103,15 @@ def test_all_ten_buildings_capture_and_restyle_the_three_masses(
         c.capture.building for c in captured if any(f.texture is None for f in c.capture.faces)
     }
     grammar = load(str(sheet))
+    # on a lot, each style is extruded to its own building's height (the section's const)
+    heights = [float(h) for h in re.findall(r"^const S\d+height = ([0-9.]+)$", text, re.M)]
+    assert len(heights) == 10 and len(set(heights)) > 5
+    for k in (0, 3, 9):
+        lot = derive(grammar, lot=(20.0, 12.0), attrs={"style": k}).mesh
+        assert np.ptp(lot.vertices[:, 1]) == pytest.approx(heights[k], abs=0.011), k
+    assert np.ptp(
+        derive(grammar, lot=(20.0, 12.0), attrs={"style": 3, "height": 30.0}).mesh.vertices[:, 1]
+    ) == pytest.approx(30.0)
     for k, building in enumerate(ids):
         for name, mass in masses.items():
             result, report = restyle(str(mass), grammar, section=k)

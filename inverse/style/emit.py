@@ -523,7 +523,10 @@ def style_text(sheets: list[tuple[Capture, Groups]], crops: Crops) -> str:
         out.append("# which captured building a lot takes (0 .. n - 1)")
     if len(sheets) > 1:
         out.append("attr style = 0")
-    out.append(f"attr height = {num(first.scale, 2)}  # metres; the source's height")
+    if len(sheets) > 1:  # a lot takes its building's own height unless one is set
+        out.append("attr height = 0  # metres; 0: the building's own (its section's height const)")
+    else:
+        out.append(f"attr height = {num(first.scale, 2)}  # metres; the source's height")
     out.append(
         "# bgr restyle: the source block a target block takes (-1: the whole building on the "
         "lot, -2: all its blocks stacked on the target block)"
@@ -546,7 +549,8 @@ def style_text(sheets: list[tuple[Capture, Groups]], crops: Crops) -> str:
             for j in range(len(capture.blocks))
         ]
         blocks.append(f"case block == -2: t(0, block_base, 0) extrude(block_height) {p}Stack")
-        starts.append((p, blocks + [f"else: extrude(height) {p}Building"]))
+        height = f"height > 0 ? height : {p}height" if p else "height"
+        starts.append((p, blocks + [f"else: extrude({height}) {p}Building"]))
     if len(starts) == 1:
         out.append(_case_rule("Lot -->", starts[0][1]))
     else:
@@ -580,6 +584,8 @@ def style_text(sheets: list[tuple[Capture, Groups]], crops: Crops) -> str:
             f"# ---- {comment_text(capture.building)}: {len(capture.blocks)} blocks, "
             f"{num(capture.scale, 2)} m high"
         )
+        if len(sheets) > 1:  # what a lot of this style is extruded to (attr height = 0)
+            out.append(_Raw(f"const S{k}height = {num(capture.scale, 2)}"))
         out.append(
             "# the source's blocks in metres, bottom to top (bgr restyle matches a mass to them)"
         )
