@@ -21,6 +21,7 @@ from .groups import Groups, face_groups
 from .model import Capture
 from .project import face_textures, roof_color
 from .remesh import capture_geometry, selection
+from .snap import snap_faces
 
 READERS = {
     ".gml": "citygml",
@@ -112,6 +113,7 @@ def capture_building(
     """Sections 4.1-4.3 for one building of ``mesh`` (None: the whole mesh as one)."""
     start = time.perf_counter()
     capture, frame = capture_geometry(mesh, building)
+    snap_faces(capture)  # section 5.2.1, on the source (snap.py says why)
     select = (
         mesh.mask(object_id=building) if building is not None else np.ones(len(mesh.faces), bool)
     )

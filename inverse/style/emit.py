@@ -368,10 +368,11 @@ class _Sheet:
         not a rectangle, one of its captured faces looking that way (a jog of an L included,
         whichever wall section 4.3.1 filed it under), chosen by its share of the side's width.
 
-        Our addition: section 5.1.3 snaps a target's faces to the source's by dynamic time
-        warping along the wall; comp(f) hands a rule one face at a time, which knows its width
-        and not its place, so the width share is what a rule can match on.  On the source's own
-        mass (bgr restyle onto it) every face finds itself; on another L the nearest share."""
+        Our addition: the paper maps a target's faces onto the source's by the blocks'
+        similarity transforms (5.1.3); comp(f) hands a rule one face at a time, which knows its
+        width and not its place, so the width share is what a rule can match on.  On the
+        source's own mass (bgr restyle onto it) every face finds itself; on another L the
+        nearest share."""
         columns = side_columns(block, w)
         metres = self.capture.scale
         xmin, xmax, zmin, zmax = block.box
