@@ -113,13 +113,13 @@ def capture_building(
     """Sections 4.1-4.3 for one building of ``mesh`` (None: the whole mesh as one)."""
     start = time.perf_counter()
     capture, frame = capture_geometry(mesh, building)
-    snap_faces(capture)  # section 5.2.1, on the source (snap.py says why)
     select = (
         mesh.mask(object_id=building) if building is not None else np.ones(len(mesh.faces), bool)
     )
     vertices = frame.apply(mesh.vertices)
     face_textures(mesh, vertices, select, capture.faces, texels_per_unit)
     capture.roof = roof_color(mesh, vertices, select)
+    snap_faces(capture)  # section 5.2.1 on the textured faces (snap.py says why)
     groups = face_groups(capture)
     return Captured(capture, groups, frame, time.perf_counter() - start)
 
