@@ -26,6 +26,7 @@ building, which is one "texture" here, so its walls never compete.
 from __future__ import annotations
 
 import math
+import os
 
 import numpy as np
 import shapely
@@ -41,6 +42,7 @@ parallel or perpendicular); 30 degrees keeps slightly tilted or sloppily modelle
 a misplaced vertex) and drops the perpendicular neighbour walls and roofs, which are 90 degrees
 away, and a wall facing the other way (180)."""
 
+MAX_THREADS = 4  # faces projected at once (threads), at most one a core
 PLANE_TOLERANCE = 0.02
 """Units of the unit-height frame (2 % of the building's height): a source triangle projects onto
 a face only if some part of it lies within this distance of the face's plane, in front or behind.
@@ -91,8 +93,23 @@ def face_textures(
     tris = _Triangles(mesh, np.asarray(vertices, dtype=np.float64), np.asarray(select, dtype=bool))
     images = _Images(mesh)
     cos_max = math.cos(math.radians(max_angle))
-    for face in faces:
+
+    def project(face: Face) -> None:
         _project_face(tris, images, face, texels_per_unit, max_size, tolerance, cos_max)
+
+    # Faces are independent and their work is mostly numpy on whole images, which releases
+    # the GIL: threads share the decoded images and use every core (each face's result is the
+    # same whichever thread computes it, so the output stays byte-identical).
+    workers = min(MAX_THREADS, os.cpu_count() or 1, len(faces))
+    if workers <= 1:
+        for face in faces:
+            project(face)
+        return
+    from concurrent.futures import ThreadPoolExecutor
+
+    with ThreadPoolExecutor(workers) as pool:
+        for _ in pool.map(project, faces):  # re-raises a face's error (an unreadable image)
+            pass
 
 
 class _Triangles:
