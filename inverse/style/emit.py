@@ -525,7 +525,8 @@ def style_text(sheets: list[tuple[Capture, Groups]], crops: Crops) -> str:
     if len(sheets) > 1:
         out.append("attr style = 0")
     if len(sheets) > 1:  # a lot takes its building's own height unless one is set
-        out.append("attr height = 0  # metres; 0: the building's own (its section's height const)")
+        out.append("attr height = 0  # metres; 0: the building's own, below")
+        out += [_Raw(f"const S{k}height = {num(c.scale, 2)}") for k, (c, _) in enumerate(sheets)]
     else:
         out.append(f"attr height = {num(first.scale, 2)}  # metres; the source's height")
     out.append(
@@ -585,8 +586,6 @@ def style_text(sheets: list[tuple[Capture, Groups]], crops: Crops) -> str:
             f"# ---- {comment_text(capture.building)}: {len(capture.blocks)} blocks, "
             f"{num(capture.scale, 2)} m high"
         )
-        if len(sheets) > 1:  # what a lot of this style is extruded to (attr height = 0)
-            out.append(_Raw(f"const S{k}height = {num(capture.scale, 2)}"))
         out.append(
             "# the source's blocks in metres, bottom to top (bgr restyle matches a mass to them)"
         )
