@@ -34,7 +34,7 @@ import shutil
 import struct
 import tempfile
 from dataclasses import dataclass
-from typing import BinaryIO
+from typing import Any, BinaryIO
 
 import numpy as np
 
@@ -76,9 +76,11 @@ class _Builder:
         data: np.ndarray,
         target: int | None = ARRAY_BUFFER,
         bounded: bool = False,
+        limits: tuple[list[float], list[float]] | None = None,
     ) -> int:
         """A view on ``data`` (rows of a block starting at byte ``start``) and its accessor,
-        with min/max if ``bounded`` (POSITION needs them)."""
+        with min/max if ``bounded`` (POSITION needs them), or ``limits`` when the caller has
+        reduced them already."""
         view = {"buffer": 0, "byteOffset": self.byte_base + start, "byteLength": int(data.nbytes)}
         if target is not None:
             view["target"] = target
@@ -89,7 +91,9 @@ class _Builder:
             "count": len(data),
             "type": f"VEC{data.shape[1]}",
         }
-        if bounded:
+        if limits is not None:
+            acc["min"], acc["max"] = [float(v) for v in limits[0]], [float(v) for v in limits[1]]
+        elif bounded:
             lo, hi = bounds(data)
             acc["min"], acc["max"] = [float(v) for v in lo], [float(v) for v in hi]
         self.accessors.append(acc)
@@ -191,6 +195,17 @@ class _Spool:
         self.count += 1
         self.nbytes += len(text)
 
+    def items(self, values: list) -> None:
+        """:meth:`item` of each of ``values``, the same bytes from one ``json.dumps`` (a part
+        of a textured style has thousands of accessors and views: a call each took a fifth of
+        writing it)."""
+        if not values:
+            return
+        text = (b"," if self.count else b"") + _json_bytes(values)[1:-1]
+        self.file.write(text)
+        self.count += len(values)
+        self.nbytes += len(text)
+
     def raw(self, data) -> None:
         self.file.write(data)
         self.nbytes += len(memoryview(data).cast("B"))
@@ -278,8 +293,11 @@ class Scene:
         fstart = face_offsets(table, p.baked, pool)
         n_corner = 3 * int(fstart[-1])
         nbytes = n_corner * CORNER_BYTES
-        new_images = [im for im in table.images if im.path not in self.images]
-        new_images = [im for k, im in enumerate(new_images) if im not in new_images[:k]]
+        fresh: dict[str, Any] = {}  # by path, first seen first: a scan per image was O(n^2)
+        for im in table.images:
+            if im.path not in self.images:
+                fresh.setdefault(im.path, im)
+        new_images = list(fresh.values())
         nbytes += sum(len(im.data) + (-len(im.data) % 4) for im in new_images)
         uvs = UvSets.of(table, p.baked, mats, self.materials.textures, pool)
         nbytes += uvs.nbytes
@@ -308,22 +326,28 @@ class Scene:
             uvs.tangents(table, p.baked, fstart, pos_data, nrm_data, pool)
             key = major[p.baked]
             cuts = np.flatnonzero(np.diff(key)) + 1
-            for lo, hi in zip(
-                np.concatenate([[0], cuts]), np.concatenate([cuts, [len(key)]]), strict=True
+            los = np.concatenate([[0], cuts])
+            corner = 3 * fstart[np.concatenate([los, [len(key)]])]
+            keep = corner[1:] > corner[:-1]  # primitives with corners: consecutive, covering
+            los, starts, ends = los[keep], corner[:-1][keep], corner[1:][keep]
+            # every primitive's POSITION min/max in two reductions, not two per primitive (a
+            # style sheet's derivation has a primitive per texture crop, thousands)
+            low = np.minimum.reduceat(pos_data, starts, axis=0).tolist() if len(starts) else []
+            high = np.maximum.reduceat(pos_data, starts, axis=0).tolist() if len(starts) else []
+            for k, (lo, first, end) in enumerate(
+                zip(los.tolist(), starts.tolist(), ends.tolist(), strict=True)
             ):
-                first, end = 3 * int(fstart[lo]), 3 * int(fstart[hi])
-                if end > first:
-                    row = p.baked[lo]
-                    attributes = {
-                        "POSITION": b.accessor(
-                            pos_at + first * 12, pos_data[first:end], bounded=True
-                        ),
-                        "NORMAL": b.accessor(nrm_at + first * 12, nrm_data[first:end]),
-                    }
-                    attributes.update(uvs.attributes(int(row), end - first, b.accessor))
-                    prims[int(groups.of_row[row])].append(
-                        {"attributes": attributes, "material": int(mats.index[row]), "mode": 4}
-                    )
+                row = p.baked[lo]
+                attributes = {
+                    "POSITION": b.accessor(
+                        pos_at + first * 12, pos_data[first:end], limits=(low[k], high[k])
+                    ),
+                    "NORMAL": b.accessor(nrm_at + first * 12, nrm_data[first:end]),
+                }
+                attributes.update(uvs.attributes(int(row), end - first, b.accessor))
+                prims[int(groups.of_row[row])].append(
+                    {"attributes": attributes, "material": int(mats.index[row]), "mode": 4}
+                )
 
         nodes: list[dict] = []  # this part's; node k is number node_base + k of the file
         node_base = 1 + sp["nodes"].count  # node 0 is the root
@@ -391,14 +415,10 @@ class Scene:
         assert b.offset == nbytes
         self.instanced |= bool(p.groups)
         self.used.update(prim["material"] for mesh in meshes for prim in mesh["primitives"])
-        for node in nodes:
-            sp["nodes"].item(node)
-        for mesh in meshes:
-            sp["meshes"].item(mesh)
-        for accessor in b.accessors:
-            sp["accessors"].item(accessor)
-        for view in b.views:
-            sp["views"].item(view)
+        sp["nodes"].items(nodes)
+        sp["meshes"].items(meshes)
+        sp["accessors"].items(b.accessors)
+        sp["views"].items(b.views)
         sp["bin"].raw(b.bin.data)
 
     def _pieces(self) -> list[bytes | _Spool]:

@@ -174,7 +174,8 @@ def _image(app, step, path) -> int:
     found = cache.get(key)
     if found is None:
         try:
-            image = load(app.module.path, app.module.roots, path, app.module.folder)
+            folders = engine.__dict__.setdefault("texture_folders", {})
+            image = load(app.module.path, app.module.roots, path, app.module.folder, folders)
         except TextureError as e:
             raise runtime_error(app.module, step.pos, e.message, e.hint) from None
         found = cache[key] = engine.table.add_image(image)
