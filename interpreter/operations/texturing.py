@@ -132,7 +132,7 @@ def setup_projection(app, shape, step, args) -> bool:
     tex = _set(shape)
     proj = list(tex.proj)
     proj[k] = m
-    shape.tex = replace(tex, proj=tuple(proj))
+    shape.tex = Texturing(tuple(proj), tex.uv, tex.color, tex.normal)  # replace() is 4x slower
     return False
 
 
@@ -148,7 +148,7 @@ def project_uv(app, shape, step, args) -> bool:
         )
     uv = list(tex.uv)
     uv[k] = tex.proj[k]
-    shape.tex = replace(tex, uv=tuple(uv))
+    shape.tex = Texturing(tex.proj, tuple(uv), tex.color, tex.normal)
     return False
 
 
@@ -183,7 +183,8 @@ def _image(app, step, path) -> int:
 
 
 def texture(app, shape, step, args) -> bool:
-    shape.tex = replace(_set(shape), color=_image(app, step, args[0]))
+    tex = _set(shape)
+    shape.tex = Texturing(tex.proj, tex.uv, _image(app, step, args[0]), tex.normal)
     return False
 
 
