@@ -39,6 +39,7 @@ from typing import Any, BinaryIO
 import numpy as np
 
 from bgr.grammar.errors import BgrError
+from bgr.grammar.parser import no_gc
 from bgr.interpreter.terminals import TerminalTable, lot_tables
 
 from .gltf_materials import MaterialIndex, UvSets, image_members
@@ -76,11 +77,10 @@ class _Builder:
         data: np.ndarray,
         target: int | None = ARRAY_BUFFER,
         bounded: bool = False,
-        limits: tuple[list[float], list[float]] | None = None,
+        limits: tuple | None = None,
     ) -> int:
         """A view on ``data`` (rows of a block starting at byte ``start``) and its accessor,
-        with min/max if ``bounded`` (POSITION needs them), or ``limits`` when the caller has
-        reduced them already."""
+        with min/max if ``bounded`` (POSITION needs them) or given (``limits``)."""
         view = {"buffer": 0, "byteOffset": self.byte_base + start, "byteLength": int(data.nbytes)}
         if target is not None:
             view["target"] = target
@@ -91,11 +91,10 @@ class _Builder:
             "count": len(data),
             "type": f"VEC{data.shape[1]}",
         }
+        if bounded and limits is None:
+            limits = bounds(data)
         if limits is not None:
             acc["min"], acc["max"] = [float(v) for v in limits[0]], [float(v) for v in limits[1]]
-        elif bounded:
-            lo, hi = bounds(data)
-            acc["min"], acc["max"] = [float(v) for v in lo], [float(v) for v in hi]
         self.accessors.append(acc)
         return self.accessor_base + len(self.accessors) - 1
 
@@ -189,19 +188,10 @@ class _Spool:
         self.count = 0
         self.nbytes = 0
 
-    def item(self, value: dict) -> None:
-        text = (b"," if self.count else b"") + _json_bytes(value)
-        self.file.write(text)
-        self.count += 1
-        self.nbytes += len(text)
-
     def items(self, values: list) -> None:
-        """:meth:`item` of each of ``values``, the same bytes from one ``json.dumps`` (a part
-        of a textured style has thousands of accessors and views: a call each took a fifth of
-        writing it)."""
-        if not values:
-            return
-        text = (b"," if self.count else b"") + _json_bytes(values)[1:-1]
+        """The array's next items, comma-separated, from one ``json.dumps`` (a part of a
+        textured style has thousands of accessors: a call each took a fifth of writing it)."""
+        text = (b"," if self.count and values else b"") + _json_bytes(values)[1:-1]
         self.file.write(text)
         self.count += len(values)
         self.nbytes += len(text)
@@ -273,6 +263,7 @@ class Scene:
     def __exit__(self, *exc) -> None:
         self.close()
 
+    @no_gc()  # thousands of dicts and no cycles: a full collection took 0.25 s of a restyle
     def add(self, table: TerminalTable) -> None:
         """Add a part: its lots' nodes (``group_by="lot"``) or its label nodes, its meshes and
         their data.  With ``group_by`` "label" or "none" a file takes one part."""
@@ -294,9 +285,8 @@ class Scene:
         n_corner = 3 * int(fstart[-1])
         nbytes = n_corner * CORNER_BYTES
         fresh: dict[str, Any] = {}  # by path, first seen first: a scan per image was O(n^2)
-        for im in table.images:
-            if im.path not in self.images:
-                fresh.setdefault(im.path, im)
+        for im in (im for im in table.images if im.path not in self.images):
+            fresh.setdefault(im.path, im)
         new_images = list(fresh.values())
         nbytes += sum(len(im.data) + (-len(im.data) % 4) for im in new_images)
         uvs = UvSets.of(table, p.baked, mats, self.materials.textures, pool)
@@ -330,10 +320,9 @@ class Scene:
             corner = 3 * fstart[np.concatenate([los, [len(key)]])]
             keep = corner[1:] > corner[:-1]  # primitives with corners: consecutive, covering
             los, starts, ends = los[keep], corner[:-1][keep], corner[1:][keep]
-            # every primitive's POSITION min/max in two reductions, not two per primitive (a
-            # style sheet's derivation has a primitive per texture crop, thousands)
-            low = np.minimum.reduceat(pos_data, starts, axis=0).tolist() if len(starts) else []
-            high = np.maximum.reduceat(pos_data, starts, axis=0).tolist() if len(starts) else []
+            # every POSITION's min/max in one go (a style: a primitive per crop, thousands)
+            low = np.minimum.reduceat(pos_data, starts, axis=0).tolist()
+            high = np.maximum.reduceat(pos_data, starts, axis=0).tolist()
             for k, (lo, first, end) in enumerate(
                 zip(los.tolist(), starts.tolist(), ends.tolist(), strict=True)
             ):

@@ -41,7 +41,13 @@ def _set(shape) -> Texturing:
     return shape.tex if shape.tex is not None else Texturing()
 
 
+_UV_SET_NUMBERS = frozenset(range(UV_SETS))
+_PLAIN = (float, int)  # exactly these classes: not bool
+
+
 def _uv_set(app, step, value) -> int:
+    if value.__class__ in _PLAIN and value in _UV_SET_NUMBERS:  # the usual case, at once
+        return int(value)
     if (
         isinstance(value, bool)
         or not isinstance(value, (int, float))
@@ -58,6 +64,8 @@ def _uv_set(app, step, value) -> int:
 
 
 def _number(app, step, value, what: str) -> float:
+    if value.__class__ is float and value - value == 0.0:  # finite: the usual case, at once
+        return value
     if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
         raise runtime_error(app.module, step.pos, f"the {what} of '{step.name}' must be a number")
     return float(value)
@@ -93,11 +101,20 @@ def _tile(app, step, value, extent: float, what: str) -> float:
 # ---- setting up and baking ----------------------------------------------------------------------
 
 
+_AXES: dict[str, tuple[str, int, int, int]] = {}
+
+
+def _axes(text: str) -> tuple[str, int, int, int]:
+    """ "scope.xy" -> ("scope", 0, 1, 2): the frame, the u and v axes and the third one."""
+    frame, pair = text.split(".")
+    i, j = "xyz".index(pair[0]), "xyz".index(pair[1])
+    found = _AXES[text] = (frame, i, j, 3 - i - j)
+    return found
+
+
 def setup_projection(app, shape, step, args) -> bool:
     k = _uv_set(app, step, args[0])
-    frame, pair = args[1].split(".")
-    i, j = "xyz".index(pair[0]), "xyz".index(pair[1])
-    w = 3 - i - j
+    frame, i, j, w = _AXES.get(args[1]) or _axes(args[1])
     if frame == "scope":
         origin, axes = shape.origin, shape.axes
         extents = shape.size
