@@ -50,14 +50,14 @@ def within(path: str | os.PathLike, roots: Iterable[Path]) -> bool:
     return inside(resolved(path), roots)
 
 
-def inside(real: Path, folders: Iterable[Path]) -> bool:
+def inside(real: str | os.PathLike, folders: Iterable[Path]) -> bool:
     """Whether the resolved path ``real`` lies inside one of the resolved ``folders``.  On POSIX
     by their text (a style sheet's derivation checks 1,300 texture paths, and pathlib's
     ``is_relative_to`` took 20 microseconds a call); elsewhere (drive letters, case-blind
     names) by ``is_relative_to``."""
     if os.sep != "/":
-        return any(real.is_relative_to(folder) for folder in folders)
-    text = str(real)
+        return any(Path(real).is_relative_to(folder) for folder in folders)
+    text = os.fspath(real)
     for folder in folders:
         top = str(folder)
         if text == top or text.startswith(top if top.endswith("/") else top + "/"):
@@ -65,7 +65,7 @@ def inside(real: Path, folders: Iterable[Path]) -> bool:
     return False
 
 
-def _special(real: Path) -> bool:
+def _special(real: str | os.PathLike) -> bool:
     return inside(real, SPECIAL_DIRS)
 
 
@@ -78,7 +78,7 @@ def check_input(path: str | os.PathLike, what: str = "file", real: bool = False)
     system call per component, and a style sheet's derivation reads 1,300 files).
     """
     shown = str(path)
-    if _special(Path(path) if real else resolved(path)):
+    if _special(path if real else resolved(path)):
         raise BgrError(
             Diagnostic(
                 shown,

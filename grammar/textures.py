@@ -20,7 +20,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from .errors import BgrError
-from .paths import ALLOW_HINT, check_input, inside, read_input, resolved
+from .paths import ALLOW_HINT, SPECIAL_DIRS, check_input, inside, read_input, resolved
 
 MIME = {"PNG": "image/png", "JPEG": "image/jpeg"}
 MAX_IMAGE_BYTES = 64 << 20  # a texture larger than this is a mistake, not a façade
@@ -63,26 +63,28 @@ def locate(
     roots: Iterable[Path],
     text: str,
     folder: Path | None = None,
-    folders: dict[Path, Path] | None = None,
+    folders: dict[str, str] | None = None,
 ) -> Path:
     """The file a texture path names, resolved (from ``folder``, the module's real folder, when
     given); :class:`TextureError` when it is out of reach.
 
     ``folders``: resolved folders already seen by the caller (a derivation's, which reads a
     style sheet's 1,300 crops from one folder): a file there that is no symlink itself is the
-    resolved folder plus its name, one ``lstat`` instead of ``realpath``'s one per component."""
+    resolved folder plus its name, one ``lstat`` instead of ``realpath``'s one per component
+    (in os.path's strings: pathlib's objects took as long again)."""
     if not isinstance(text, str) or not text or "\0" in text:
         raise TextureError(f"{text!r} is not a texture file name", 'write texture("file.png")')
-    joined = (folder or base_folder(module_path)) / text
+    joined = os.path.join(folder or base_folder(module_path), text)
     path = None
-    if folders is not None and joined.name not in ("", ".", ".."):
-        parent = folders.get(joined.parent)
+    head, name = os.path.split(joined)
+    if folders is not None and name not in ("", ".", ".."):
+        parent = folders.get(head)
         if parent is None:
-            parent = folders[joined.parent] = resolved(joined.parent)
-        candidate = parent / joined.name
+            parent = folders[head] = str(resolved(head))
+        candidate = os.path.join(parent, name)
         try:
             if not stat.S_ISLNK(os.lstat(candidate).st_mode):
-                path = candidate
+                path = Path(candidate)
         except OSError:
             pass  # missing or unreadable: realpath and the reader say what it is
     if path is None:
@@ -100,8 +102,9 @@ def read_image(path: Path, shown: str, real: bool = False) -> Image:
     """Read and identify a PNG or JPEG file; :class:`TextureError` says what is wrong.
     ``real``: ``path`` is resolved already (:func:`locate`'s), so not resolved again."""
     try:
-        check_input(path, "texture file", real=real)  # /proc, /sys, /dev, FIFOs: before stat
-        if path.stat().st_size > MAX_IMAGE_BYTES:
+        if not real or inside(path, SPECIAL_DIRS):  # /proc, /sys, /dev, FIFOs: before stat
+            check_input(path, "texture file", real=real)
+        if os.stat(path).st_size > MAX_IMAGE_BYTES:
             raise TextureError(
                 f"texture file '{shown[:200]}' is larger than {MAX_IMAGE_BYTES >> 20} MB"
             )
