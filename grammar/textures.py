@@ -213,7 +213,7 @@ def load(
     roots: Iterable[Path],
     text: str,
     folder: Path | None = None,
-    folders: dict[Path, Path] | None = None,
+    folders: dict[str, str] | None = None,
 ) -> Image:
     """:func:`locate` then :func:`read_image`."""
     return read_image(locate(module_path, roots, text, folder, folders), text, real=True)
