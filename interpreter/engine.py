@@ -160,12 +160,14 @@ class Engine:
             )
         seen = set()
 
-        def prepare(g, over):
+        # ``again``: itself, passed in; a closure naming itself is a reference cycle that
+        # would hold the engine (and its compiled expressions) until a cyclic collection
+        def prepare(g, over, again):
             if id(g) in seen:
                 return
             seen.add(id(g))
             for sub in g.imports.values():
-                prepare(sub, {})
+                again(sub, {}, again)
             values = evaluate_values(g, over, self.compilers, self.seed, self.lot_index)
             for name, value in values.items():
                 if isinstance(value, float) and not math.isfinite(value):
@@ -177,7 +179,7 @@ class Engine:
                         "a product or power overflowed? Keep values below 1e308",
                     )
 
-        prepare(grammar, overrides)
+        prepare(grammar, overrides, prepare)
         values = self.compilers[id(grammar)].values
         return {k: values[k] for k in grammar.attrs}
 
@@ -229,6 +231,16 @@ class Engine:
             if gc_was_on:
                 gc.enable()
         return self.table
+
+    def release(self) -> None:
+        """Drop the derivation's compiled expressions and plans: they hold the engine and its
+        compilers in reference cycles, which otherwise wait for the cyclic collector (55,000
+        objects after a style sheet's derivation, 0.1 s to collect)."""
+        for compiler in self.compilers.values():
+            compiler.funcs.clear()
+        self.compilers.clear()
+        for cache in (self._exprs, self.signatures, self.binders, self.targets, self._bindings):
+            cache.clear()
 
     def binding_problem(self, ref: RuleRef, step: n.Successor):
         """bind_problem() for a rule held in a parameter, cached per (successor, rule)."""
