@@ -34,11 +34,12 @@ import shutil
 import struct
 import tempfile
 from dataclasses import dataclass
-from typing import BinaryIO
+from typing import Any, BinaryIO
 
 import numpy as np
 
 from bgr.grammar.errors import BgrError
+from bgr.grammar.parser import no_gc
 from bgr.interpreter.terminals import TerminalTable, lot_tables
 
 from .gltf_materials import MaterialIndex, UvSets, image_members
@@ -76,9 +77,10 @@ class _Builder:
         data: np.ndarray,
         target: int | None = ARRAY_BUFFER,
         bounded: bool = False,
+        limits: tuple | None = None,
     ) -> int:
         """A view on ``data`` (rows of a block starting at byte ``start``) and its accessor,
-        with min/max if ``bounded`` (POSITION needs them)."""
+        with min/max if ``bounded`` (POSITION needs them) or given (``limits``)."""
         view = {"buffer": 0, "byteOffset": self.byte_base + start, "byteLength": int(data.nbytes)}
         if target is not None:
             view["target"] = target
@@ -89,9 +91,10 @@ class _Builder:
             "count": len(data),
             "type": f"VEC{data.shape[1]}",
         }
-        if bounded:
-            lo, hi = bounds(data)
-            acc["min"], acc["max"] = [float(v) for v in lo], [float(v) for v in hi]
+        if bounded and limits is None:
+            limits = bounds(data)
+        if limits is not None:
+            acc["min"], acc["max"] = [float(v) for v in limits[0]], [float(v) for v in limits[1]]
         self.accessors.append(acc)
         return self.accessor_base + len(self.accessors) - 1
 
@@ -185,10 +188,12 @@ class _Spool:
         self.count = 0
         self.nbytes = 0
 
-    def item(self, value: dict) -> None:
-        text = (b"," if self.count else b"") + _json_bytes(value)
+    def items(self, values: list) -> None:
+        """The array's next items, comma-separated, from one ``json.dumps`` (a part of a
+        textured style has thousands of accessors: a call each took a fifth of writing it)."""
+        text = (b"," if self.count and values else b"") + _json_bytes(values)[1:-1]
         self.file.write(text)
-        self.count += 1
+        self.count += len(values)
         self.nbytes += len(text)
 
     def raw(self, data) -> None:
@@ -258,6 +263,7 @@ class Scene:
     def __exit__(self, *exc) -> None:
         self.close()
 
+    @no_gc()  # thousands of dicts and no cycles: a full collection took 0.25 s of a restyle
     def add(self, table: TerminalTable) -> None:
         """Add a part: its lots' nodes (``group_by="lot"``) or its label nodes, its meshes and
         their data.  With ``group_by`` "label" or "none" a file takes one part."""
@@ -278,8 +284,10 @@ class Scene:
         fstart = face_offsets(table, p.baked, pool)
         n_corner = 3 * int(fstart[-1])
         nbytes = n_corner * CORNER_BYTES
-        new_images = [im for im in table.images if im.path not in self.images]
-        new_images = [im for k, im in enumerate(new_images) if im not in new_images[:k]]
+        fresh: dict[str, Any] = {}  # by path, first seen first: a scan per image was O(n^2)
+        for im in (im for im in table.images if im.path not in self.images):
+            fresh.setdefault(im.path, im)
+        new_images = list(fresh.values())
         nbytes += sum(len(im.data) + (-len(im.data) % 4) for im in new_images)
         uvs = UvSets.of(table, p.baked, mats, self.materials.textures, pool)
         nbytes += uvs.nbytes
@@ -308,22 +316,27 @@ class Scene:
             uvs.tangents(table, p.baked, fstart, pos_data, nrm_data, pool)
             key = major[p.baked]
             cuts = np.flatnonzero(np.diff(key)) + 1
-            for lo, hi in zip(
-                np.concatenate([[0], cuts]), np.concatenate([cuts, [len(key)]]), strict=True
+            los = np.concatenate([[0], cuts])
+            corner = 3 * fstart[np.concatenate([los, [len(key)]])]
+            keep = corner[1:] > corner[:-1]  # primitives with corners: consecutive, covering
+            los, starts, ends = los[keep], corner[:-1][keep], corner[1:][keep]
+            # every POSITION's min/max in one go (a style: a primitive per crop, thousands)
+            low = np.minimum.reduceat(pos_data, starts, axis=0).tolist()
+            high = np.maximum.reduceat(pos_data, starts, axis=0).tolist()
+            for k, (lo, first, end) in enumerate(
+                zip(los.tolist(), starts.tolist(), ends.tolist(), strict=True)
             ):
-                first, end = 3 * int(fstart[lo]), 3 * int(fstart[hi])
-                if end > first:
-                    row = p.baked[lo]
-                    attributes = {
-                        "POSITION": b.accessor(
-                            pos_at + first * 12, pos_data[first:end], bounded=True
-                        ),
-                        "NORMAL": b.accessor(nrm_at + first * 12, nrm_data[first:end]),
-                    }
-                    attributes.update(uvs.attributes(int(row), end - first, b.accessor))
-                    prims[int(groups.of_row[row])].append(
-                        {"attributes": attributes, "material": int(mats.index[row]), "mode": 4}
-                    )
+                row = p.baked[lo]
+                attributes = {
+                    "POSITION": b.accessor(
+                        pos_at + first * 12, pos_data[first:end], limits=(low[k], high[k])
+                    ),
+                    "NORMAL": b.accessor(nrm_at + first * 12, nrm_data[first:end]),
+                }
+                attributes.update(uvs.attributes(int(row), end - first, b.accessor))
+                prims[int(groups.of_row[row])].append(
+                    {"attributes": attributes, "material": int(mats.index[row]), "mode": 4}
+                )
 
         nodes: list[dict] = []  # this part's; node k is number node_base + k of the file
         node_base = 1 + sp["nodes"].count  # node 0 is the root
@@ -391,14 +404,10 @@ class Scene:
         assert b.offset == nbytes
         self.instanced |= bool(p.groups)
         self.used.update(prim["material"] for mesh in meshes for prim in mesh["primitives"])
-        for node in nodes:
-            sp["nodes"].item(node)
-        for mesh in meshes:
-            sp["meshes"].item(mesh)
-        for accessor in b.accessors:
-            sp["accessors"].item(accessor)
-        for view in b.views:
-            sp["views"].item(view)
+        sp["nodes"].items(nodes)
+        sp["meshes"].items(meshes)
+        sp["accessors"].items(b.accessors)
+        sp["views"].items(b.views)
         sp["bin"].raw(b.bin.data)
 
     def _pieces(self) -> list[bytes | _Spool]:

@@ -6,6 +6,7 @@ same colour share a material.
 
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass
 
 import numpy as np
@@ -30,9 +31,16 @@ class Materials:
 
     def linear(self, k: int) -> list[float]:
         """The colour in linear light (glTF's baseColorFactor), from its sRGB bytes."""
-        c = self.rgb8[k].astype(np.float64) / 255.0
-        lin = np.where(c <= 0.04045, c / 12.92, ((c + 0.055) / 1.055) ** 2.4)
-        return [round(float(v), 6) for v in lin]
+        return list(_linear(self.rgb8[k].astype(np.uint8, copy=False).tobytes()))
+
+
+@functools.lru_cache(maxsize=4096)
+def _linear(rgb: bytes) -> tuple[float, ...]:
+    """:meth:`Materials.linear` of three sRGB bytes, worked out once per colour (a textured
+    style writes a material per crop, thousands in a few colours)."""
+    c = np.frombuffer(rgb, dtype=np.uint8).astype(np.float64) / 255.0
+    lin = np.where(c <= 0.04045, c / 12.92, ((c + 0.055) / 1.055) ** 2.4)
+    return tuple(round(float(v), 6) for v in lin)
 
 
 def materials_of(table: TerminalTable) -> Materials:

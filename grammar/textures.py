@@ -10,13 +10,17 @@ one), so a missing or broken image is a located error, never a traceback or a bl
 from __future__ import annotations
 
 import io
+import os
 import re
+import stat
+import threading
+from collections import OrderedDict
 from collections.abc import Iterable
 from dataclasses import dataclass
 from pathlib import Path
 
 from .errors import BgrError
-from .paths import ALLOW_HINT, check_input, read_input, within
+from .paths import ALLOW_HINT, SPECIAL_DIRS, check_input, inside, read_input, resolved
 
 MIME = {"PNG": "image/png", "JPEG": "image/jpeg"}
 MAX_IMAGE_BYTES = 64 << 20  # a texture larger than this is a mistake, not a façade
@@ -54,14 +58,39 @@ def base_folder(module_path: str) -> Path:
     return Path(module_path).parent
 
 
-def locate(module_path: str, roots: Iterable[Path], text: str, folder: Path | None = None) -> Path:
+def locate(
+    module_path: str,
+    roots: Iterable[Path],
+    text: str,
+    folder: Path | None = None,
+    folders: dict[str, str] | None = None,
+) -> Path:
     """The file a texture path names, resolved (from ``folder``, the module's real folder, when
-    given); :class:`TextureError` when it is out of reach."""
+    given); :class:`TextureError` when it is out of reach.
+
+    ``folders``: resolved folders already seen by the caller (a derivation's, which reads a
+    style sheet's 1,300 crops from one folder): a file there that is no symlink itself is the
+    resolved folder plus its name, one ``lstat`` instead of ``realpath``'s one per component
+    (in os.path's strings: pathlib's objects took as long again)."""
     if not isinstance(text, str) or not text or "\0" in text:
         raise TextureError(f"{text!r} is not a texture file name", 'write texture("file.png")')
-    path = ((folder or base_folder(module_path)) / text).resolve()
+    joined = os.path.join(folder or base_folder(module_path), text)
+    path = None
+    head, name = os.path.split(joined)
+    if folders is not None and name not in ("", ".", ".."):
+        parent = folders.get(head)
+        if parent is None:
+            parent = folders[head] = str(resolved(head))
+        candidate = os.path.join(parent, name)
+        try:
+            if not stat.S_ISLNK(os.lstat(candidate).st_mode):
+                path = Path(candidate)
+        except OSError:
+            pass  # missing or unreadable: realpath and the reader say what it is
+    if path is None:
+        path = resolved(joined)
     roots = tuple(roots)
-    if roots and not within(path, roots):
+    if roots and not inside(path, roots):  # resolved once: within() would resolve it again
         raise TextureError(
             f"texture file '{text[:200]}' is outside the folders this grammar may read",
             ALLOW_HINT,
@@ -69,15 +98,17 @@ def locate(module_path: str, roots: Iterable[Path], text: str, folder: Path | No
     return path
 
 
-def read_image(path: Path, shown: str) -> Image:
-    """Read and identify a PNG or JPEG file; :class:`TextureError` says what is wrong."""
+def read_image(path: Path, shown: str, real: bool = False) -> Image:
+    """Read and identify a PNG or JPEG file; :class:`TextureError` says what is wrong.
+    ``real``: ``path`` is resolved already (:func:`locate`'s), so not resolved again."""
     try:
-        check_input(path, "texture file")
-        if path.stat().st_size > MAX_IMAGE_BYTES:
+        if not real or inside(path, SPECIAL_DIRS):  # /proc, /sys, /dev, FIFOs: before stat
+            check_input(path, "texture file", real=real)
+        if os.stat(path).st_size > MAX_IMAGE_BYTES:
             raise TextureError(
                 f"texture file '{shown[:200]}' is larger than {MAX_IMAGE_BYTES >> 20} MB"
             )
-        data = read_input(path, "texture file")
+        data = read_input(path, "texture file", real=real)
     except BgrError as e:
         raise TextureError(e.message, e.hint) from None
     except FileNotFoundError:
@@ -87,7 +118,44 @@ def read_image(path: Path, shown: str) -> Image:
     except (OSError, ValueError) as e:
         reason = getattr(e, "strerror", None) or str(e)
         raise TextureError(f"texture file '{shown[:200]}' cannot be read: {reason}") from None
-    return decode_image(data, str(path), shown)
+    return _decoded(data, str(path), shown)
+
+
+# the images read_image decoded in this process, by resolved path, least recently used first;
+# at most DECODED_BYTES of file bytes (a style sheet's crops are a few KB each)
+_DECODED: OrderedDict[str, Image] = OrderedDict()
+_DECODED_SIZE = [0]
+_DECODED_LOCK = threading.Lock()
+DECODED_BYTES = 64 << 20
+
+
+def _decoded(data: bytes, key: str, shown: str) -> Image:
+    """:func:`decode_image`, remembered across derivations and loads in this process.
+
+    Why: a style sheet names 1,000-3,000 crop files, and checking the sheet, then each
+    derivation with it (``bgr restyle``: one per mass), decoded every one again, 0.5 ms each,
+    most of a retargeted generation's time.  The file is still read every time and the cached
+    image is used only when its bytes are the same (a file changed on disk, even within one
+    mtime tick, is decoded anew); only the decoding, which depends on nothing but the bytes,
+    is skipped.  A failure is not remembered."""
+    with _DECODED_LOCK:
+        known = _DECODED.get(key)
+        if known is not None and known.data == data:
+            _DECODED.move_to_end(key)
+            return known
+    image = decode_image(data, key, shown)
+    if len(data) > DECODED_BYTES // 16:
+        return image
+    with _DECODED_LOCK:
+        old = _DECODED.pop(key, None)
+        if old is not None:
+            _DECODED_SIZE[0] -= len(old.data)
+        _DECODED[key] = image
+        _DECODED_SIZE[0] += len(data)
+        while _DECODED_SIZE[0] > DECODED_BYTES:
+            _, dropped = _DECODED.popitem(last=False)
+            _DECODED_SIZE[0] -= len(dropped.data)
+    return image
 
 
 def decode_image(data: bytes, key: str, shown: str) -> Image:
@@ -140,6 +208,12 @@ def open_image(data: bytes):
     return img
 
 
-def load(module_path: str, roots: Iterable[Path], text: str, folder: Path | None = None) -> Image:
+def load(
+    module_path: str,
+    roots: Iterable[Path],
+    text: str,
+    folder: Path | None = None,
+    folders: dict[str, str] | None = None,
+) -> Image:
     """:func:`locate` then :func:`read_image`."""
-    return read_image(locate(module_path, roots, text, folder), text)
+    return read_image(locate(module_path, roots, text, folder, folders), text, real=True)

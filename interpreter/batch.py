@@ -136,7 +136,10 @@ def derive_lot(
         if cache is not None:
             engine.split_cache = cache
         engine.shapes, engine.triangles = shapes, triangles
-        engine.derive(lot.shape.copy(), job.start, index=index, several=job.several)
+        try:
+            engine.derive(lot.shape.copy(), job.start, index=index, several=job.several)
+        finally:
+            engine.release()
     except BgrError as e:
         return LotResult(index, None, list(warnings.items), error=naming(e, name))
     rule = job.start or job.grammar.start

@@ -147,7 +147,9 @@ def prepare(
     warnings = Warnings(strict)
     lots = _lots(lot, warnings, lot_options)
     site_of(lots)
-    values = Engine(grammar, seed, attrs, max_depth, max_shapes).attrs  # the run's attrs
+    probe = Engine(grammar, seed, attrs, max_depth, max_shapes)
+    values = probe.attrs  # the run's attrs
+    probe.release()
     if max_memory is None:
         max_memory = default_max_memory()
     job = Job(

@@ -98,6 +98,8 @@ class TerminalTable:
     # UnitMesh.uv) instead of tex_uv's map; frozen: (K,) bool
     tex_own: Any = field(default_factory=list)
     frozen: bool = False
+    # add_image's index: (the images list it was built for, its length then, path -> index)
+    _image_at: tuple = field(default=(None, 0, None), init=False, repr=False, compare=False)
 
     def __len__(self) -> int:
         return len(self.label)
@@ -122,12 +124,22 @@ class TerminalTable:
         return self
 
     def add_image(self, image) -> int:
-        """The index of a texture image, each distinct file (resolved path) stored once."""
-        for k, known in enumerate(self.images):
-            if known.path == image.path:
-                return k
-        self.images.append(image)
-        return len(self.images) - 1
+        """The index of a texture image, each distinct file (resolved path) stored once: looked
+        up by path in a dict, not by a scan of ``images`` (a style sheet's derivation adds
+        1,300 crops, and a scan per crop was a tenth of its time).  The dict is rebuilt when
+        ``images`` was replaced or grown by another hand (``texture_part`` shares a list)."""
+        images = self.images
+        owner, count, at = self._image_at
+        if owner is not images or count != len(images):
+            at = {}
+            for k, known in enumerate(images):
+                at.setdefault(known.path, k)
+        found = at.get(image.path)
+        if found is None:
+            found = at[image.path] = len(images)
+            images.append(image)
+        self._image_at = (images, len(images), at)
+        return found
 
     def add_texturing(self, row: int, tex, own: int = -1) -> None:
         """Record the texture maps and coordinates of terminal ``row`` (a shape's

@@ -41,7 +41,13 @@ def _set(shape) -> Texturing:
     return shape.tex if shape.tex is not None else Texturing()
 
 
+_UV_SET_NUMBERS = frozenset(range(UV_SETS))
+_PLAIN = (float, int)  # exactly these classes: not bool
+
+
 def _uv_set(app, step, value) -> int:
+    if value.__class__ in _PLAIN and value in _UV_SET_NUMBERS:  # the usual case, at once
+        return int(value)
     if (
         isinstance(value, bool)
         or not isinstance(value, (int, float))
@@ -58,6 +64,8 @@ def _uv_set(app, step, value) -> int:
 
 
 def _number(app, step, value, what: str) -> float:
+    if value.__class__ is float and value - value == 0.0:  # finite: the usual case, at once
+        return value
     if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
         raise runtime_error(app.module, step.pos, f"the {what} of '{step.name}' must be a number")
     return float(value)
@@ -93,11 +101,20 @@ def _tile(app, step, value, extent: float, what: str) -> float:
 # ---- setting up and baking ----------------------------------------------------------------------
 
 
+_AXES: dict[str, tuple[str, int, int, int]] = {}
+
+
+def _axes(text: str) -> tuple[str, int, int, int]:
+    """ "scope.xy" -> ("scope", 0, 1, 2): the frame, the u and v axes and the third one."""
+    frame, pair = text.split(".")
+    i, j = "xyz".index(pair[0]), "xyz".index(pair[1])
+    found = _AXES[text] = (frame, i, j, 3 - i - j)
+    return found
+
+
 def setup_projection(app, shape, step, args) -> bool:
     k = _uv_set(app, step, args[0])
-    frame, pair = args[1].split(".")
-    i, j = "xyz".index(pair[0]), "xyz".index(pair[1])
-    w = 3 - i - j
+    frame, i, j, w = _AXES.get(args[1]) or _axes(args[1])
     if frame == "scope":
         origin, axes = shape.origin, shape.axes
         extents = shape.size
@@ -132,7 +149,7 @@ def setup_projection(app, shape, step, args) -> bool:
     tex = _set(shape)
     proj = list(tex.proj)
     proj[k] = m
-    shape.tex = replace(tex, proj=tuple(proj))
+    shape.tex = Texturing(tuple(proj), tex.uv, tex.color, tex.normal)  # replace() is 4x slower
     return False
 
 
@@ -148,7 +165,7 @@ def project_uv(app, shape, step, args) -> bool:
         )
     uv = list(tex.uv)
     uv[k] = tex.proj[k]
-    shape.tex = replace(tex, uv=tuple(uv))
+    shape.tex = Texturing(tex.proj, tuple(uv), tex.color, tex.normal)
     return False
 
 
@@ -174,7 +191,8 @@ def _image(app, step, path) -> int:
     found = cache.get(key)
     if found is None:
         try:
-            image = load(app.module.path, app.module.roots, path, app.module.folder)
+            folders = engine.__dict__.setdefault("texture_folders", {})
+            image = load(app.module.path, app.module.roots, path, app.module.folder, folders)
         except TextureError as e:
             raise runtime_error(app.module, step.pos, e.message, e.hint) from None
         found = cache[key] = engine.table.add_image(image)
@@ -182,7 +200,8 @@ def _image(app, step, path) -> int:
 
 
 def texture(app, shape, step, args) -> bool:
-    shape.tex = replace(_set(shape), color=_image(app, step, args[0]))
+    tex = _set(shape)
+    shape.tex = Texturing(tex.proj, tex.uv, _image(app, step, args[0]), tex.normal)
     return False
 
 

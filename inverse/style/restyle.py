@@ -25,6 +25,7 @@ import numpy as np
 from bgr.grammar import nodes as n
 from bgr.grammar.checker import Grammar
 from bgr.grammar.errors import BgrError, Diagnostic
+from bgr.grammar.parser import no_gc
 
 STACK = -2
 """The sheet's ``block`` value for all source blocks stacked on one target block."""
@@ -155,6 +156,7 @@ def thinnest(ring: np.ndarray, samples: int = 5) -> tuple[float, float]:
     return out[0], out[1]
 
 
+@no_gc()  # numpy work and a derivation, no cycles: a full collection took 0.25 s of a restyle
 def restyle(
     mass: str,
     style: str | Grammar,
@@ -163,17 +165,22 @@ def restyle(
     allow_paths: Iterable[str | os.PathLike] = (),
 ):
     """The styled mass (a bgr.interpreter.derive.Result) and a one-line report.  ``style`` is
-    the sheet's path or the sheet already loaded (a sheet of many buildings takes seconds to
-    load: put each of its sections on many masses with one load)."""
-    from bgr.grammar.loader import load
+    the sheet's path (then only its section ``section`` is loaded and checked, where the sheet
+    is laid out as bgr infer writes it: sections.py) or the sheet already loaded (a sheet of
+    many buildings takes seconds to load: put each of its sections on many masses with one
+    load)."""
     from bgr.interpreter.derive import derive
     from bgr.interpreter.lots import footprint
 
     from .capture import read_model
     from .remesh import capture_geometry
+    from .sections import load_section
 
-    grammar = style if isinstance(style, Grammar) else load(style, allow_paths=allow_paths)
-    several = "S0block0_width" in grammar.consts
+    if isinstance(style, Grammar):
+        grammar, alone = style, False
+    else:  # the section alone when the sheet is laid out as emit writes it (sections.py)
+        grammar, alone = load_section(style, section, allow_paths)
+    several = alone or "S0block0_width" in grammar.consts
     if (
         section
         and not several
