@@ -1,11 +1,11 @@
 """One section of a style sheet, loaded without the others: ``bgr restyle --section N``.
 
-A sheet of several buildings (emit.style_text) is a header (attrs, ``Lot`` choosing
-``S<k>Lot`` by ``attr style``, the ``S<k>Lot`` rules, Wall/Window/Bay, the ``SplitX<m>`` /
-``SplitY<m>`` rules of equations 8-9 that any section uses) and one ``# ---- `` section per
-building whose consts and rules all start with ``S<k>``.  Loading and checking the whole
-PLATEAU sheet (10 buildings, 5,500 lines) took 3 s, Lark reading about 200 KB a second, of
-which a restyle uses one section.
+A sheet of several buildings (emit.style_text) is a header (attrs, the buildings' heights
+``const S<k>height``, ``Lot`` choosing ``S<k>Lot`` by ``attr style``, the ``S<k>Lot`` rules,
+Wall/Window/Bay, the ``SplitX<m>`` / ``SplitY<m>`` rules of equations 8-9 that any section
+uses) and one ``# ---- `` section per building whose consts and rules all start with
+``S<k>``.  Loading and checking the whole PLATEAU sheet (10 buildings, 5,500 lines) took 3 s,
+Lark reading about 200 KB a second, of which a restyle uses one section.
 
 :func:`section_text` keeps the header and section N, and blanks every other line (line numbers
 and columns stay those of the file, so a message points into the file as it is): the other
@@ -31,6 +31,7 @@ _HEAD = re.compile(r"[A-Za-z_][A-Za-z0-9_]*")  # a line starting at column 0 wit
 _SPLIT = re.compile(r"(Split[XY]\d+)(?:Fit|Y|Run|Scaled)?")
 _SPLIT_USE = re.compile(r"\b(Split[XY]\d+)\(")
 _SECTION_NAME = re.compile(r"\bS(\d+)[A-Za-z_]")
+_HEIGHT = re.compile(r"const S(\d+)height = ")  # a building's height, in the header
 
 
 def _extents(lines: list[str], first: int, end: int) -> list[tuple[str, int, int]]:
@@ -90,6 +91,9 @@ def section_text(text: str, section: int) -> str | None:
             out[first] = f"Lot --> S{section}Lot"
         elif re.fullmatch(r"S\d+Lot", name):
             if name == f"S{section}Lot":
+                out[first:end] = lines[first:end]
+        elif name == "const" and (height := _HEIGHT.match(lines[first])):
+            if int(height[1]) == section:  # the buildings' heights: this one's only
                 out[first:end] = lines[first:end]
         elif split is None or split[1] in used:
             out[first:end] = lines[first:end]
