@@ -27,6 +27,7 @@ from __future__ import annotations
 
 import math
 import os
+import threading
 
 import numpy as np
 import shapely
@@ -168,9 +169,14 @@ class _Images:
     def __init__(self, mesh: TexturedMesh) -> None:
         self.mesh = mesh
         self.cache: dict[tuple[int, int], np.ndarray] = {}
+        self.lock = threading.Lock()  # faces are projected in threads: decode each image once
 
     def __call__(self, material: int, factor: int = 1) -> np.ndarray:
         """(h, w, 3) float32: the image, reduced ``factor`` times in each direction."""
+        with self.lock:
+            return self._get(material, factor)
+
+    def _get(self, material: int, factor: int) -> np.ndarray:
         if (material, 1) not in self.cache:
             self.cache[material, 1] = self._decode(material)
         if (material, factor) not in self.cache:
