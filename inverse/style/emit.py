@@ -482,16 +482,19 @@ def side_columns(block: Block, w: int) -> list[tuple[Face, list[Face | None]]]:
         a, b = float(f.start @ axis), float(f.end @ axis)
         return (min(a, b), max(a, b))
 
-    def on(level: int) -> list[Face]:
-        return [f for faces in block.walls for f in faces if f.level == level and looks(f)]
+    facing: dict[int, list[Face]] = {level: [] for level in block.levels}
+    for faces in block.walls:
+        for f in faces:
+            if f.level in facing and looks(f):
+                facing[f.level].append(f)
 
     out: list[tuple[Face, list[Face | None]]] = []
-    for first in sorted(on(block.levels[0]), key=lambda f: span(f)[0]):
+    for first in sorted(facing[block.levels[0]], key=lambda f: span(f)[0]):
         a0, a1 = span(first)
         column: list[Face | None] = []
         for level in block.levels:
             best, most = None, 0.0
-            for f in on(level):
+            for f in facing[level]:
                 b0, b1 = span(f)
                 overlap = min(a1, b1) - max(a0, b0)
                 if overlap > most:
