@@ -87,8 +87,18 @@ class Pool:
     """``workers`` processes started from ``context`` (a multiprocessing context), each having
     run ``initializer(*initargs)`` once."""
 
-    def __init__(self, workers: int, context, initializer: Callable, initargs: tuple) -> None:
+    def __init__(
+        self,
+        workers: int,
+        context,
+        initializer: Callable,
+        initargs: tuple,
+        doing: str = "deriving",
+        memory_hint: str = "run with fewer --workers or a lower --max-memory",
+    ) -> None:
         self._workers: list[_Worker] = []
+        self._doing = doing  # what errors say a worker was doing: "deriving lot 3"
+        self._memory_hint = memory_hint
         # a run interrupted outside ordered() (Ctrl-C while the caller writes a lot) leaves the
         # generator suspended until the interpreter tears it down, after multiprocessing has
         # closed the processes' sentinels; end the workers before that, while join still works
@@ -163,7 +173,7 @@ class Pool:
                     raise self._died(worker, describe) from None
                 if not ok:
                     raise BgrError(
-                        f"internal error in a worker process while deriving "
+                        f"internal error in a worker process while {self._doing} "
                         f"{describe(worker.task[1])}:\n{value}"
                     )
                 done[worker.task[0]] = value
@@ -171,8 +181,7 @@ class Pool:
             elif worker.process.sentinel in ready:
                 raise self._died(worker, describe)
 
-    @staticmethod
-    def _died(worker: _Worker, describe: Callable[[Any], str]) -> WorkerDied:
+    def _died(self, worker: _Worker, describe: Callable[[Any], str]) -> WorkerDied:
         code = worker.process.exitcode
         if code is not None and code < 0:
             try:
@@ -187,9 +196,9 @@ class Pool:
                 "",
                 0,
                 0,
-                f"worker process {worker.process.name} {how} while deriving {doing}",
+                f"worker process {worker.process.name} {how} while {self._doing} {doing}",
                 "a worker killed by signal 9 was most likely stopped by the system for want of "
-                "memory: run with fewer --workers or a lower --max-memory",
+                f"memory: {self._memory_hint}",
             )
         )
 

@@ -28,6 +28,7 @@ from __future__ import annotations
 import math
 import os
 import threading
+from dataclasses import dataclass
 
 import numpy as np
 import shapely
@@ -43,7 +44,11 @@ parallel or perpendicular); 30 degrees keeps slightly tilted or sloppily modelle
 a misplaced vertex) and drops the perpendicular neighbour walls and roofs, which are 90 degrees
 away, and a wall facing the other way (180)."""
 
-MAX_THREADS = 4  # faces projected at once (threads), at most one a core
+MAX_THREADS = 4  # faces drawn at once (threads), at most one a core
+THREADED_PIXELS = 16_384
+"""Faces of at least this many pixels (128 x 128) are drawn in threads, smaller ones in the
+calling thread: measured on PLATEAU (median 200 pixels a face) and the tessellated synthetic
+building (median 100,000), threads pay only on the large."""
 PLANE_TOLERANCE = 0.02
 """Units of the unit-height frame (2 % of the building's height): a source triangle projects onto
 a face only if some part of it lies within this distance of the face's plane, in front or behind.
@@ -94,23 +99,30 @@ def face_textures(
     tris = _Triangles(mesh, np.asarray(vertices, dtype=np.float64), np.asarray(select, dtype=bool))
     images = _Images(mesh)
     cos_max = math.cos(math.radians(max_angle))
-
-    def project(face: Face) -> None:
-        _project_face(tris, images, face, texels_per_unit, max_size, tolerance, cos_max)
-
-    # Faces are independent and their work is mostly numpy on whole images, which releases
-    # the GIL: threads share the decoded images and use every core (each face's result is the
-    # same whichever thread computes it, so the output stays byte-identical).
-    workers = min(MAX_THREADS, os.cpu_count() or 1, len(faces))
+    # Which triangles reach a face, which image wins it and its grid: small shapely and numpy
+    # steps that hold the GIL, so one thread.  Then the pixels: a large face's are numpy on
+    # whole arrays, which releases the GIL, so they go to threads; a small face's cost the
+    # per-call overhead of a thread hand-off and are drawn here (PLATEAU's 500 faces have a
+    # median of 200 pixels: threads made its capture slower).
+    plans = [
+        _plan_face(tris, images, face, texels_per_unit, max_size, tolerance, cos_max)
+        for face in faces
+    ]
+    large = [plan for plan in plans if plan is not None and plan.pixels >= THREADED_PIXELS]
+    for plan in plans:
+        if plan is not None and plan.pixels < THREADED_PIXELS:
+            _paint_face(tris, images, plan)
+    # each face's result is the same whichever thread computes it: output byte-identical
+    workers = min(MAX_THREADS, os.cpu_count() or 1, len(large))
     if workers <= 1:
-        for face in faces:
-            project(face)
+        for plan in large:
+            _paint_face(tris, images, plan)
         return
     from concurrent.futures import ThreadPoolExecutor
 
     with ThreadPoolExecutor(workers) as pool:
-        for _ in pool.map(project, faces):  # re-raises a face's error (an unreadable image)
-            pass
+        for _ in pool.map(lambda plan: _paint_face(tris, images, plan), large):
+            pass  # re-raises a face's error (an unreadable image)
 
 
 class _Triangles:
@@ -119,6 +131,7 @@ class _Triangles:
     def __init__(self, mesh: TexturedMesh, vertices: np.ndarray, select: np.ndarray) -> None:
         keep = np.flatnonzero(select & (mesh.material >= 0))
         self.corners = vertices[mesh.faces[keep]]  # (K, 3, 3)
+        self.plan = self.corners[:, :, [0, 2]]  # (K, 3, 2): x, z, what a face's plane sees
         cross = np.cross(
             self.corners[:, 1] - self.corners[:, 0], self.corners[:, 2] - self.corners[:, 0]
         )
@@ -139,14 +152,14 @@ class _Triangles:
         d, n = face_axes(face)
         n3 = np.array([n[0], 0.0, n[1]])
         facing = self.normal @ n3  # cosine of the angle between the normals
-        near = (self.textured == textured) & (facing >= cos_max)
+        parallel = np.flatnonzero((self.textured == textured) & (facing >= cos_max))
         start = np.asarray(face.start, dtype=np.float64)
-        rel = self.corners[:, :, [0, 2]] - start  # (K, 3, 2) from the face's left end
-        dist = rel @ n  # (K, 3) signed distance of each corner in front of the plane
-        near &= (dist.min(axis=1) <= tolerance) & (dist.max(axis=1) >= -tolerance)
-        index = np.flatnonzero(near)
+        rel = self.plan[parallel] - start  # (k, 3, 2) from the face's left end
+        dist = rel @ n  # (k, 3) signed distance of each corner in front of the plane
+        near = (dist.min(axis=1) <= tolerance) & (dist.max(axis=1) >= -tolerance)
+        index, dist = parallel[near], dist[near]
         # along the triangle's own normal (section 4.1): p - n_s * dist / (n_s . n_f)
-        shift = dist[index] / facing[index][:, None]  # (k, 3)
+        shift = dist / facing[index][:, None]  # (k, 3)
         moved = self.corners[index] - shift[:, :, None] * self.normal[index][:, None, :]
         proj = np.stack([(moved[:, :, [0, 2]] - start) @ d, moved[:, :, 1]], axis=-1)
         lo, hi = proj.min(axis=1), proj.max(axis=1)
@@ -157,7 +170,7 @@ class _Triangles:
             & (lo[:, 1] < face.top - eps)
             & (hi[:, 1] > face.bottom + eps)
         )
-        front = dist[index].mean(axis=1)
+        front = dist.mean(axis=1)
         return index[overlap], proj[overlap], front[overlap]
 
 
@@ -215,7 +228,27 @@ class _Images:
             ) from None
 
 
-def _project_face(
+@dataclass
+class _Plan:
+    """A textured face's projection before its pixels are drawn: the winning image's triangles
+    (indices, projections in (u, y), distances in front of the plane), the grid and the image
+    reduction to sample."""
+
+    face: Face
+    winner: int
+    index: np.ndarray
+    proj: np.ndarray
+    front: np.ndarray
+    cols: int
+    rows: int
+    factor: int
+
+    @property
+    def pixels(self) -> int:
+        return self.cols * self.rows
+
+
+def _plan_face(
     tris: _Triangles,
     images: _Images,
     face: Face,
@@ -223,7 +256,9 @@ def _project_face(
     max_size: int,
     tolerance: float,
     cos_max: float,
-) -> None:
+) -> _Plan | None:
+    """The face's projection (section 4.1: the image covering the largest area wins), or None
+    for a face no image covers enough, which gets its plain colour here."""
     width, height = face.width, face.height
     index, proj, front = tris.reaching(face, tolerance, cos_max, textured=True)
     winner, cover = _largest_cover(proj, tris.material[index], face)
@@ -232,15 +267,23 @@ def _project_face(
         color = _plain_color(tris, face, tolerance, cos_max)
         if color is not None:
             face.color = color
-        return
+        return None
     mine = tris.material[index] == winner
     index, proj, front = index[mine], proj[mine], front[mine]
     source = _density(proj, tris.uv[index], images(winner).shape)
     cols, rows = _grid(width, height, texels_per_unit or source, max_size)
     step = source * width / cols  # source texels a face pixel spans
-    image = images(winner, 2 ** int(np.log2(step)) if step >= 2 else 1)
-    uv, covered = _raster(proj, tris.uv[index], np.argsort(front, kind="stable"), face, cols, rows)
-    wrap = images.mesh.materials[winner].wrap
+    factor = 2 ** int(np.log2(step)) if step >= 2 else 1
+    return _Plan(face, winner, index, proj, front, cols, rows, factor)
+
+
+def _paint_face(tris: _Triangles, images: _Images, plan: _Plan) -> None:
+    """Draw a planned face's rectified texture and its mean colour."""
+    face, index, cols, rows = plan.face, plan.index, plan.cols, plan.rows
+    image = images(plan.winner, plan.factor)
+    order = np.argsort(plan.front, kind="stable")
+    uv, covered = _raster(plan.proj, tris.uv[index], order, face, cols, rows)
+    wrap = images.mesh.materials[plan.winner].wrap
     texture = np.empty((rows, cols, 3), dtype=np.float32)
     if covered.all():  # the usual case: no mask to gather through or scatter back
         texture.reshape(-1, 3)[:] = _bilinear(image, wrapped(uv.reshape(-1, 2), wrap))
@@ -264,11 +307,16 @@ def _largest_cover(proj: np.ndarray, material: np.ndarray, face: Face) -> tuple[
     if len(proj) == 0:
         return -1, 0.0
     rect = shapely.box(0.0, face.bottom, face.width, face.top)
-    polys = shapely.polygons(proj)
     kinds = np.unique(material)  # ascending: the first of equal areas wins
-    if len(kinds) == 1:
-        clipped = float(shapely.area(shapely.intersection(polys, rect)).sum())
+    if len(kinds) == 1:  # the triangles inside the rectangle need no clipping
+        lo, hi = proj.min(axis=1), proj.max(axis=1)
+        inside = (lo[:, 0] >= 0) & (hi[:, 0] <= face.width)
+        inside &= (lo[:, 1] >= face.bottom) & (hi[:, 1] <= face.top)
+        crossing = shapely.polygons(proj[~inside])
+        clipped = float(_areas(proj[inside]).sum())
+        clipped += float(shapely.area(shapely.intersection(crossing, rect)).sum())
         return int(kinds[0]), min(clipped, face.width * face.height)
+    polys = shapely.polygons(proj)
     best, area = -1, 0.0
     for m in kinds:
         covered = shapely.intersection(shapely.union_all(polys[material == m]), rect).area
@@ -317,10 +365,10 @@ def _raster(
         [proj[:, :, 0] * (cols / face.width), (face.top - proj[:, :, 1]) * (rows / face.height)],
         axis=-1,
     )
-    out = np.zeros((rows, cols, 2))
-    covered = np.zeros((rows, cols), dtype=bool)
     lo = np.clip(np.ceil(px.min(axis=1) - 0.5), 0, [cols, rows]).astype(np.int64)
     hi = np.clip(np.floor(px.max(axis=1) - 0.5) + 1, 0, [cols, rows]).astype(np.int64)
+    out = np.zeros((rows, cols, 2))
+    covered = np.zeros((rows, cols), dtype=bool)
     for t in order:
         (j0, i0), (j1, i1) = lo[t], hi[t]
         if j1 <= j0 or i1 <= i0:
