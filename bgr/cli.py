@@ -246,14 +246,16 @@ def build_parser() -> argparse.ArgumentParser:
         metavar="INPUT",
         help="a city (.obj, .ply, .glb, .gltf, .city.json, .city.jsonl), a box hierarchy "
         ".json for --kind boxes, a terminal list .json, captured-model .json or .bgr for "
-        "--kind schema, or a textured model (.gml, .xml, .obj, .glb, .gltf) for --kind style",
+        "--kind schema, a textured model (.gml, .xml, .obj, .glb, .gltf) for --kind style, or a "
+        "rectified façade photograph (.jpg, .png) for --kind facade",
     )
     infer.add_argument(
         "--kind",
-        choices=["schema", "city", "boxes", "style", "image"],
+        choices=["schema", "city", "boxes", "style", "facade", "image"],
         default=None,
         help="what to infer (default: city for 3D models and CityJSON, boxes for a box "
-        "hierarchy .json, style for CityGML, schema otherwise; image is not written yet)",
+        "hierarchy .json, style for CityGML, schema otherwise; facade parses a rectified "
+        "façade photograph; image is not written yet)",
     )
     infer.add_argument(
         "-o", "--output", metavar="OUT.bgr", help="write here (default: standard output)"
@@ -286,6 +288,9 @@ def build_parser() -> argparse.ArgumentParser:
     from .inverse.style.command import add_infer_options, add_restyle_parser
 
     add_infer_options(infer)
+    from .inverse.image.command import add_facade_options
+
+    add_facade_options(infer)
     city = infer.add_argument_group("--kind city")
     city.add_argument(
         "--assets",
@@ -810,10 +815,14 @@ def _infer(args) -> int:
         from .inverse.style.command import run_infer as run_style
 
         return run_style(args)
+    if kind == "facade":
+        from .inverse.image.command import run_facade
+
+        return run_facade(args)
     if kind != "schema":
         print(
-            f"bgr infer: --kind {kind} is not written yet; --kind schema, city, boxes and "
-            "style are",
+            f"bgr infer: --kind {kind} is not written yet; --kind schema, city, boxes, style "
+            "and facade are",
             file=sys.stderr,
         )
         return EXIT_INPUT

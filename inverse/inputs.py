@@ -21,7 +21,8 @@ READS = (
     "bgr infer reads --kind schema: a terminal list (.json, from bgr derive -o x.json), a "
     "captured model (.json) or a grammar (.bgr); --kind city: a 3D city (.obj, .ply, .glb, "
     '.gltf, .city.json, .city.jsonl); --kind boxes: a box hierarchy (.json with a "root" box); '
-    "--kind style: a textured building (.gml, .xml, .obj, .glb, .gltf)"
+    "--kind style: a textured building (.gml, .xml, .obj, .glb, .gltf); --kind facade: a "
+    "rectified façade photograph (.jpg, .png)"
 )
 
 # magic numbers of the files people give by mistake: (prefix, what it is)

@@ -1,0 +1,137 @@
+"""Train the window-pixel perceptron of bgr.inverse.image.pixels on the CMP façades (issue 28),
+with five-fold cross-validation, and write its weights.
+
+    python bench/train_facade.py [--cmp DIR] [--out inverse/image/window_pixels.npz]
+
+Each façade is resampled to :data:`bgr.inverse.image.facade.WORK_HEIGHT` rows, its features
+computed there, and :data:`SAMPLES` pixels drawn from it (a fixed seed); the label of a pixel is
+"window" for CMP window (3), door (4) and shop (12), as the paper's Table 4 counts them.  The
+perceptron (:data:`HIDDEN` tanh units, logistic output) is fitted by Adam on the cross-entropy;
+the decision threshold is the one that maximises window F1 on the training pixels.  Five folds
+of 20 façades in file order: each fold's model is trained on the other 80 and scored on its 20
+by ``bench/facade_cmp.py``'s measures; the shipped weights are trained on all 100.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+from PIL import Image
+
+ROOT = Path(__file__).resolve().parent.parent
+sys.path.insert(0, str(ROOT / "bench"))
+
+SAMPLES = 4000  # pixels drawn from each façade
+HIDDEN = 16
+STEPS = 3000
+BATCH = 4096
+SEED = 28
+
+
+def load(photo: Path) -> tuple[np.ndarray, np.ndarray]:
+    """(features (n, F), labels (n,)) of SAMPLES pixels of a façade at the working scale."""
+    from bgr.inverse.image.facade import working_image
+    from bgr.inverse.image.pixels import FEATURES, features
+
+    rgb = np.asarray(Image.open(photo).convert("RGB"))
+    labels = np.asarray(Image.open(photo.with_suffix(".png")))
+    work = working_image(rgb)
+    small = np.asarray(
+        Image.fromarray(labels).resize((work.shape[1], work.shape[0]), Image.Resampling.NEAREST)
+    )
+    x = features(work).reshape(-1, FEATURES)
+    y = np.isin(small, (3, 4, 12)).reshape(-1)
+    rng = np.random.default_rng([SEED, int(photo.stem[-4:])])
+    pick = rng.choice(len(x), min(SAMPLES, len(x)), replace=False)
+    return x[pick], y[pick]
+
+
+def train(x: np.ndarray, y: np.ndarray, seed: int = SEED) -> dict[str, np.ndarray]:
+    """The perceptron fitted to (x, y) by Adam, and its F1-best threshold."""
+    from bgr.inverse.image.pixels import forward
+
+    rng = np.random.default_rng(seed)
+    mean, std = x.mean(axis=0), x.std(axis=0) + 1e-6
+    z = (x - mean) / std
+    f = x.shape[1]
+    params = {
+        "w1": rng.normal(0, 1 / np.sqrt(f), (f, HIDDEN)),
+        "b1": np.zeros(HIDDEN),
+        "w2": rng.normal(0, 1 / np.sqrt(HIDDEN), (HIDDEN, 1)),
+        "b2": np.zeros(1),
+    }
+    m = {k: np.zeros_like(v) for k, v in params.items()}
+    v = {k: np.zeros_like(p) for k, p in params.items()}
+    target = y.astype(np.float64)
+    for step in range(1, STEPS + 1):
+        batch = rng.integers(0, len(z), BATCH)
+        zb, tb = z[batch], target[batch]
+        hidden = np.tanh(zb @ params["w1"] + params["b1"])
+        p = 1 / (1 + np.exp(-(hidden @ params["w2"] + params["b2"])[:, 0]))
+        d_out = (p - tb)[:, None] / BATCH
+        grads = {
+            "w2": hidden.T @ d_out,
+            "b2": d_out.sum(axis=0),
+        }
+        d_hidden = (d_out @ params["w2"].T) * (1 - hidden**2)
+        grads["w1"] = zb.T @ d_hidden
+        grads["b1"] = d_hidden.sum(axis=0)
+        rate = 0.01 if step < 0.7 * STEPS else 0.002
+        for k in params:
+            m[k] = 0.9 * m[k] + 0.1 * grads[k]
+            v[k] = 0.999 * v[k] + 0.001 * grads[k] ** 2
+            mhat = m[k] / (1 - 0.9**step)
+            vhat = v[k] / (1 - 0.999**step)
+            params[k] -= rate * mhat / (np.sqrt(vhat) + 1e-8)
+    net = {"mean": mean, "std": std, **params}
+    prob = forward(net, x)
+    best, best_f1 = 0.5, -1.0
+    for t in np.linspace(0.2, 0.8, 25):
+        guess = prob >= t
+        tp = (guess & y).sum()
+        f1 = 2 * tp / max(1, 2 * tp + (guess & ~y).sum() + (~guess & y).sum())
+        if f1 > best_f1:
+            best, best_f1 = float(t), float(f1)
+    net["threshold"] = np.array(best)
+    return {k: np.asarray(val, dtype=np.float64) for k, val in net.items()}
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--cmp", type=Path, default=ROOT.parent / "shared/data/facades/cmp")
+    ap.add_argument("--out", type=Path, default=ROOT / "inverse/image/window_pixels.npz")
+    ap.add_argument("--folds", type=int, default=5)
+    args = ap.parse_args()
+    import facade_cmp
+
+    photos = sorted(args.cmp.glob("cmp_b*.jpg"))
+    if not photos:
+        sys.exit(f"{args.cmp}: no CMP façades here")
+    start = time.perf_counter()
+    data = [load(p) for p in photos]
+    print(f"features of {len(photos)} façades in {time.perf_counter() - start:.1f} s")
+    size = len(photos) // args.folds
+    rows = []
+    for k in range(args.folds):
+        test = set(range(k * size, (k + 1) * size if k < args.folds - 1 else len(photos)))
+        xs = np.concatenate([data[i][0] for i in range(len(photos)) if i not in test])
+        ys = np.concatenate([data[i][1] for i in range(len(photos)) if i not in test])
+        t0 = time.perf_counter()
+        net = train(xs, ys)
+        fold = facade_cmp.evaluate([photos[i] for i in sorted(test)], net)
+        rows += fold
+        print(
+            f"fold {k + 1}: trained in {time.perf_counter() - t0:.1f} s, {facade_cmp.summary(fold)}"
+        )
+    print(f"cross-validated, all {len(rows)}: {facade_cmp.summary(rows)}")
+    net = train(np.concatenate([d[0] for d in data]), np.concatenate([d[1] for d in data]))
+    np.savez(args.out, **net)
+    print(f"wrote {args.out} ({args.out.stat().st_size} bytes)")
+
+
+if __name__ == "__main__":
+    main()

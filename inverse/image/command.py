@@ -1,0 +1,167 @@
+"""``bgr infer FACADE.jpg --kind facade -o f.bgr [--label-map L.png]``: a rectified façade
+photograph parsed (:mod:`.facade`) and written as a grammar of the stdlib's ``fac.Grid``."""
+
+from __future__ import annotations
+
+import statistics
+import sys
+from pathlib import Path
+
+import numpy as np
+
+from bgr.grammar.errors import BgrError, Diagnostic, terminal_text
+
+from .facade import FacadeParse, parse_facade
+
+# the CMP palette's first colours, so that a label map opens in any viewer as CMP's do
+PALETTE = [0, 0, 0, 0, 0, 170, 0, 0, 255, 0, 85, 255, 0, 170, 255]
+
+
+def add_facade_options(infer) -> None:
+    group = infer.add_argument_group("--kind facade")
+    group.add_argument(
+        "--label-map",
+        metavar="PNG",
+        help="also write the parse as a palette PNG of the photograph's size with the CMP "
+        "label ids (2 facade, 3 window)",
+    )
+    group.add_argument(
+        "--floor-height",
+        type=float,
+        default=3.2,
+        metavar="M",
+        help="storey height in metres that scales the photograph (default 3.2)",
+    )
+
+
+def read_photo(path: str) -> np.ndarray:
+    """(h, w, 3) uint8 of a photograph (a regular file Pillow reads, at most 8192 x 4096
+    pixels as every image bgr reads), or a located error."""
+    from PIL import UnidentifiedImageError
+
+    from bgr.grammar.paths import read_input
+    from bgr.grammar.textures import open_image
+
+    try:
+        data = read_input(path, "photograph")
+    except FileNotFoundError:
+        raise BgrError(Diagnostic(path, 0, 0, "no such file", "check the path")) from None
+    except OSError as exc:
+        raise BgrError(
+            Diagnostic(path, 0, 0, f"cannot read the photograph: {exc.strerror or exc}", "")
+        ) from None
+    try:
+        with open_image(data) as image:
+            rgb = np.asarray(image.convert("RGB"))
+    except Exception as exc:  # Pillow raises many kinds for bytes that are no image
+        unread = isinstance(exc, UnidentifiedImageError)
+        why = "it is not an image Pillow reads" if unread else str(exc)
+        raise BgrError(
+            Diagnostic(path, 0, 0, f"cannot read the photograph: {why}", "give a JPEG or PNG")
+        ) from None
+    if min(rgb.shape[:2]) < 16:
+        raise BgrError(
+            Diagnostic(
+                path,
+                0,
+                0,
+                f"the photograph is {rgb.shape[1]} x {rgb.shape[0]} pixels: too small to parse",
+                "give a façade photograph at least 16 pixels on each side",
+            )
+        )
+    return rgb
+
+
+def facade_grammar(parse: FacadeParse, source: str, floor_height: float) -> str:
+    """The parse as a grammar: a slab the photograph's size (scaled so that the floors are
+    ``floor_height`` metres apart) whose front is the stdlib's ``fac.Grid`` with the parse's
+    floors, tiles, windows and colour."""
+    boxes = parse.windows
+    floors = [boxes[f] for f in parse.floors]
+    centres = [float(np.median((f[:, 0] + f[:, 2]) / 2)) for f in floors]
+    pitch = (
+        float(np.median(np.diff(centres)))
+        if len(centres) > 1
+        else parse.height / max(1, len(floors))
+    )
+    scale = floor_height / pitch  # metres a pixel
+    width, height = parse.width * scale, parse.height * scale
+    counts = parse.windows_per_floor()
+    columns = int(statistics.median(counts)) if counts else 1
+    win_w = float(np.median(boxes[:, 3] - boxes[:, 1])) * scale if len(boxes) else 0.0
+    win_h = float(np.median(boxes[:, 2] - boxes[:, 0])) * scale if len(boxes) else 0.0
+    bottoms = [parse.floor_bounds[k + 1] - float(np.median(f[:, 2])) for k, f in enumerate(floors)]
+    sill = max(0.0, statistics.median(bottoms)) * scale if bottoms else 0.0
+    left = float(boxes[:, 1].min()) * scale if len(boxes) else 0.0
+    right = width - float(boxes[:, 3].max()) * scale if len(boxes) else 0.0
+    tile = (width - left - right + win_w) / max(1, columns)  # the windows' pitch
+    margin = max(0.0, min(left, right) - (tile - win_w) / 2)
+    color = "#{:02x}{:02x}{:02x}".format(*parse.color)
+    # fac.Grid fits round(height / floor_h) floors and round(room / tile_w) tiles: the parse's
+    # counts, exactly, with these
+    values = {
+        "width": width,
+        "height": height,
+        "floor_h": height / max(1, len(floors)),
+        "tile_w": (width - 2 * margin) / max(1, columns),
+        "win_w": win_w,
+        "win_h": win_h,
+        "sill_h": sill,
+        "margin": margin,
+    }
+    lines = [
+        f"# {_comment(Path(source).name)}: a façade parsed by bgr infer --kind facade, "
+        f"{len(counts)} floors of {', '.join(map(str, counts)) or 'no'} windows",
+        f"# (scaled so that its floors are {floor_height:g} m apart)",
+        "version 1",
+        "",
+        "import stdlib.facade as fac",
+        "",
+        *(f"attr {name} = {value:.3f}".rstrip("0").rstrip(".") for name, value in values.items()),
+        f'attr wall_color = "{color}"',
+        "",
+        "Lot --> s(width, 0, 0.3) extrude(height) "
+        "comp(f) { front: Facade | all: color(wall_color) }",
+        "Facade --> fac.Grid(floor_h = floor_h, tile_w = tile_w, win_w = win_w, win_h = win_h, "
+        "sill_h = sill_h, margin = margin, wall_color = wall_color)",
+    ]
+    from bgr.grammar.formatter import format_source
+
+    return format_source("\n".join(lines) + "\n")
+
+
+def _comment(text: str) -> str:
+    return terminal_text(text, keep="").replace("\n", " ")
+
+
+def run_facade(args) -> int:
+    from PIL import Image
+
+    from bgr.formats.atomic import atomic_files, write_text
+
+    if not args.floor_height > 0 or not np.isfinite(args.floor_height):
+        print("bgr infer: --floor-height must be a positive number of metres", file=sys.stderr)
+        return 2
+    from bgr.grammar.paths import check_output
+
+    for target in (args.output, args.label_map):
+        if target not in (None, "-"):
+            check_output(target)
+    parse = parse_facade(read_photo(args.input))
+    text = facade_grammar(parse, args.input, args.floor_height)
+    if args.label_map:
+        labels = Image.fromarray(parse.label_map(), mode="P")
+        labels.putpalette(PALETTE)
+        with atomic_files([Path(args.label_map)]) as (out,):
+            labels.save(out, format="PNG")
+    if args.output in (None, "-"):
+        sys.stdout.write(text)
+    else:
+        write_text(Path(args.output), text)
+    counts = parse.windows_per_floor()
+    print(
+        f"{terminal_text(args.input, keep='')}: {len(counts)} floors, "
+        f"{sum(counts)} windows, façade colour #{'{:02x}{:02x}{:02x}'.format(*parse.color)}",
+        file=sys.stderr,
+    )
+    return 0
