@@ -8,11 +8,14 @@ measured on the CMP façades by ``bench/facade_cmp.py`` and ``bench/train_facade
    grid its floor / column CNN proposes.  Here a small per-pixel perceptron
    (:mod:`.pixels`, trained on CMP) gives each pixel's window probability, the gradient
    projections of section 5.2 (``V(y) = sum_x |dI/dx|``, ``H(x) = sum_y |dI/dy|``) among its
-   features; the windows are the connected regions above its threshold.
-2. **Grid.**  Floors are the rows of windows (windows whose vertical extents overlap by more
-   than half join one floor), columns likewise; floor boundaries lie midway between window rows.
-   Not yet: the paper's refinement of the boundaries on the minima of V and H within 75 %-140 %
-   of the estimate, and the regularisation of the window sizes per floor.
+   features; pixels above its threshold are window.
+2. **Grid** (:func:`window_grid`), read off that window map as section 5.2 reads the gradient
+   projections: floors are the runs of rows with many window pixels, and in each floor the
+   windows are the runs of columns with window pixels in most of its rows; so every window is a
+   box and the boxes make the label map (the paper's simplified façade image).  Floor
+   boundaries lie midway between window rows.  Not yet: the paper's refinement of the
+   boundaries on the minima of V and H within 75 %-140 % of the estimate, the regularisation
+   of window sizes per floor, and the façade and window style recognition.
 3. **Façade colour** (section 5.4, as stated): k-means with k = 10 in L*a*b* on the pixels
    outside the windows; the largest cluster's centre.
 """
@@ -34,7 +37,8 @@ weights are at one scale whatever the photograph's size."""
 
 ROW_LEVEL = 0.35
 """A row belongs to a floor's window band when its share of window pixels is at least this
-fraction of the highest row's."""
+fraction of the highest row's (the default: trained weights carry their own, chosen on the
+training façades by ``bench/train_facade.py``)."""
 
 SLIVER = 0.35
 """A floor band (a window) lower (narrower) than this fraction of the median of its façade's
@@ -42,7 +46,7 @@ SLIVER = 0.35
 
 COLUMN_LEVEL = 0.5
 """In a floor's band, a column is a window's when at least this share of the band's rows are
-window pixels there."""
+window pixels there (likewise a default)."""
 
 COLOR_CLUSTERS = 10  # section 5.4: "k = 10 clusters for all our results"
 
@@ -99,7 +103,8 @@ def gradient_projections(gray: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 def rows_of(extents: list[tuple[float, float]]) -> list[list[int]]:
     """Indices of ``extents`` (start, end) grouped into rows, in order of their centres: an
     extent joins the last row when it overlaps that row's median extent by more than half of
-    the shorter of the two (the same rule groups the truth's boxes in ``bench/facade_cmp.py``)."""
+    the shorter of the two.  How ``bench/facade_cmp.py`` counts the floors of a labelled façade
+    from its window boxes (the truth the parse's floors are scored against)."""
     order = sorted(range(len(extents)), key=lambda i: sum(extents[i]) / 2)
     rows: list[list[int]] = []
     for i in order:
@@ -147,21 +152,23 @@ def runs(profile: np.ndarray, level: float, shortest: int) -> list[tuple[int, in
     ]
 
 
-def window_grid(mask: np.ndarray) -> list[list[tuple[int, int, int, int]]]:
+def window_grid(
+    mask: np.ndarray, row_level: float = ROW_LEVEL, column_level: float = COLUMN_LEVEL
+) -> list[list[tuple[int, int, int, int]]]:
     """Windows floor by floor, (top, left, bottom, right) each, read off a window mask as the
     grid of section 5.2 reads the gradient projections: floors are the runs of rows whose share
     of window pixels is high (:data:`ROW_LEVEL` of the highest), and in each floor the windows
     are the runs of columns with window pixels in most of the floor's rows."""
     height, width = mask.shape
     share = ndimage.uniform_filter1d(mask.mean(axis=1), 3)
-    bands = runs(share, ROW_LEVEL * share.max(), max(2, height // 100))
+    bands = runs(share, row_level * share.max(), max(2, height // 100))
     if bands:  # a band much lower than the others is a ledge or a shadow's edge, not a floor
         tall = np.median([b - a for a, b in bands])
         bands = [(a, b) for a, b in bands if b - a >= SLIVER * tall]
     floors = []
     for top, bottom in bands:
         across = mask[top:bottom].mean(axis=0)
-        cells = runs(across, COLUMN_LEVEL, max(2, width // 200))
+        cells = runs(across, column_level, max(2, width // 200))
         if cells:  # likewise a window much narrower than its floor's others
             wide = np.median([b - a for a, b in cells])
             cells = [(a, b) for a, b in cells if b - a >= SLIVER * wide]
@@ -177,7 +184,8 @@ def parse_facade(rgb: np.ndarray, net: dict[str, np.ndarray] | None = None) -> F
     work = working_image(rgb)
     prob = window_probability(work, net)
     small = prob >= float(net["threshold"])
-    grid = window_grid(small)
+    levels = {k: float(net[k]) for k in ("row_level", "column_level") if k in net}
+    grid = window_grid(small, **levels)
     sy, sx = height / work.shape[0], width / work.shape[1]
     windows = np.array(
         [(t * sy, x0 * sx, b * sy, x1 * sx) for floor in grid for t, x0, b, x1 in floor]
