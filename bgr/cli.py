@@ -246,8 +246,9 @@ def build_parser() -> argparse.ArgumentParser:
         metavar="INPUT",
         help="a city (.obj, .ply, .glb, .gltf, .city.json, .city.jsonl), a box hierarchy "
         ".json for --kind boxes, a terminal list .json, captured-model .json or .bgr for "
-        "--kind schema, a textured model (.gml, .xml, .obj, .glb, .gltf) for --kind style, or a "
-        "rectified façade photograph (.jpg, .png) for --kind facade",
+        "--kind schema, a textured model (.gml, .xml, .obj, .glb, .gltf) for --kind style, a "
+        "rectified façade photograph (.jpg, .png) for --kind facade, or a photograph of a "
+        "building for --kind image",
     )
     infer.add_argument(
         "--kind",
@@ -255,7 +256,7 @@ def build_parser() -> argparse.ArgumentParser:
         default=None,
         help="what to infer (default: city for 3D models and CityJSON, boxes for a box "
         "hierarchy .json, style for CityGML, schema otherwise; facade parses a rectified "
-        "façade photograph; image is not written yet)",
+        "façade photograph; image fits a building to a photograph and its outline)",
     )
     infer.add_argument(
         "-o", "--output", metavar="OUT.bgr", help="write here (default: standard output)"
@@ -819,13 +820,10 @@ def _infer(args) -> int:
         from .inverse.image.command import run_facade
 
         return run_facade(args)
-    if kind != "schema":
-        print(
-            f"bgr infer: --kind {kind} is not written yet; --kind schema, city, boxes, style "
-            "and facade are",
-            file=sys.stderr,
-        )
-        return EXIT_INPUT
+    if kind == "image":
+        from .inverse.image.photo import run_image
+
+        return run_image(args)
     fixed: dict[str, bool] = {}
     for option, value in (("--fixed", True), ("--stretch", False)):
         for label in filter(None, (x.strip() for x in getattr(args, option[2:]).split(","))):

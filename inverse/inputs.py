@@ -22,7 +22,8 @@ READS = (
     "captured model (.json) or a grammar (.bgr); --kind city: a 3D city (.obj, .ply, .glb, "
     '.gltf, .city.json, .city.jsonl); --kind boxes: a box hierarchy (.json with a "root" box); '
     "--kind style: a textured building (.gml, .xml, .obj, .glb, .gltf); --kind facade: a "
-    "rectified façade photograph (.jpg, .png)"
+    "rectified façade photograph (.jpg, .png); --kind image: a photograph of a building with "
+    "--silhouette"
 )
 
 # magic numbers of the files people give by mistake: (prefix, what it is)

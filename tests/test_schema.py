@@ -266,9 +266,15 @@ def test_cli_bad_inputs_exit_1_with_the_element_named(tmp_path, capsys, content,
     assert not out.exists()
 
 
-def test_cli_other_kinds_say_they_are_not_written(capsys):
+def test_cli_kind_image_asks_for_the_outline_then_refuses_a_grammar(capsys, tmp_path):
     assert main(["infer", str(DATA / "palazzo.bgr"), "--kind", "image"]) == 1
-    assert "--kind image is not written yet" in capsys.readouterr().err
+    assert "--kind image needs the building's outline" in capsys.readouterr().err
+    outline = tmp_path / "sil.json"
+    outline.write_text("[[1, 1], [9, 1], [9, 9]]")
+    args = ["infer", str(DATA / "palazzo.bgr"), "--kind", "image", "--silhouette", str(outline)]
+    assert main(args) == 1
+    err = capsys.readouterr().err
+    assert "cannot read the photograph" in err and "Traceback" not in err
 
 
 def test_cli_kind_style_refuses_a_grammar_saying_what_it_reads(capsys):

@@ -32,6 +32,18 @@ def add_facade_options(infer) -> None:
         metavar="M",
         help="storey height in metres that scales the photograph (default 3.2)",
     )
+    image = infer.add_argument_group("--kind image")
+    image.add_argument(
+        "--silhouette",
+        metavar="SIL",
+        help="the building's outline in the photograph: a JSON list of [x, y] pixel points or "
+        "a mask PNG (white on black)",
+    )
+    image.add_argument(
+        "--preview",
+        metavar="PNG",
+        help="also write the fitted model rendered over the photograph, with the outline",
+    )
 
 
 def read_photo(path: str) -> np.ndarray:
@@ -72,10 +84,10 @@ def read_photo(path: str) -> np.ndarray:
     return rgb
 
 
-def facade_grammar(parse: FacadeParse, source: str, floor_height: float) -> str:
-    """The parse as a grammar: a slab the photograph's size (scaled so that the floors are
-    ``floor_height`` metres apart) whose front is the stdlib's ``fac.Grid`` with the parse's
-    floors, tiles, windows and colour."""
+def grid_values(parse: FacadeParse, floor_height: float) -> dict[str, float]:
+    """The parse as the parameters of the stdlib's ``fac.Grid`` (and the façade's ``width`` and
+    ``height``), in metres: the photograph scaled so that the floors are ``floor_height``
+    metres apart."""
     boxes = parse.windows
     floors = [boxes[f] for f in parse.floors]
     centres = [float(np.median((f[:, 0] + f[:, 2]) / 2)) for f in floors]
@@ -96,10 +108,9 @@ def facade_grammar(parse: FacadeParse, source: str, floor_height: float) -> str:
     right = width - float(boxes[:, 3].max()) * scale if len(boxes) else 0.0
     tile = (width - left - right + win_w) / max(1, columns)  # the windows' pitch
     margin = max(0.0, min(left, right) - (tile - win_w) / 2)
-    color = "#{:02x}{:02x}{:02x}".format(*parse.color)
     # fac.Grid fits round(height / floor_h) floors and round(room / tile_w) tiles: the parse's
     # counts, exactly, with these
-    values = {
+    return {
         "width": width,
         "height": height,
         "floor_h": height / max(1, len(floors)),
@@ -109,6 +120,15 @@ def facade_grammar(parse: FacadeParse, source: str, floor_height: float) -> str:
         "sill_h": sill,
         "margin": margin,
     }
+
+
+def facade_grammar(parse: FacadeParse, source: str, floor_height: float) -> str:
+    """The parse as a grammar: a slab the photograph's size (scaled so that the floors are
+    ``floor_height`` metres apart) whose front is the stdlib's ``fac.Grid`` with the parse's
+    floors, tiles, windows and colour."""
+    values = grid_values(parse, floor_height)
+    counts = parse.windows_per_floor()
+    color = "#{:02x}{:02x}{:02x}".format(*parse.color)
     lines = [
         f"# {_comment(Path(source).name)}: a façade parsed by bgr infer --kind facade, "
         f"{len(counts)} floors of {', '.join(map(str, counts)) or 'no'} windows",
