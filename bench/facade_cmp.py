@@ -14,8 +14,9 @@ photograph, then
   shares most); windows per floor is the median count over the floors.  RMSE over the façades
   of the parse's floors and median windows per floor against those.
 
-Prints the figures (means over the façades) and the five folds' (cross-validation folds of 20
-façades in file order; the parse has no trained parameters yet, so each fold is a test set).
+Prints the figures (means over the façades) of the shipped weights (trained on all of them:
+``bench/train_facade.py`` prints the cross-validated ones); ``--no-refine`` parses without
+section 5.2's boundary refinement.
 """
 
 from __future__ import annotations
@@ -65,26 +66,36 @@ def scores(predicted: np.ndarray, labels: np.ndarray) -> tuple[float, int, int, 
     )
 
 
-def evaluate(photos: list[Path], net: dict | None = None) -> list[tuple]:
+def evaluate(
+    photos: list[Path], net: dict | None = None, refine: bool | None = None
+) -> list[tuple]:
     """A row of measures for each façade: (pixel accuracy, window TP, FP, FN, floors error,
-    windows-per-floor error, seconds)."""
-    from bgr.inverse.image.facade import parse_facade
+    windows-per-floor error, seconds); ``refine`` False: without section 5.2's refinement."""
+    from bgr.inverse.image import facade
 
     rows = []
     for photo in photos:
         rgb = np.asarray(Image.open(photo).convert("RGB"))
-        labels = np.asarray(Image.open(photo.with_suffix(".png")))
-        floors, per_floor = truth_grid(photo.with_suffix(".xml").read_text())
         start = time.perf_counter()
-        parse = parse_facade(rgb, net)
-        seconds = time.perf_counter() - start
-        counts = parse.windows_per_floor()
-        got_per_floor = int(statistics.median(counts or [0]))
-        accuracy, tp, fp, fn = scores(parse.label_map(), labels)
-        rows.append(
-            (accuracy, tp, fp, fn, len(counts) - floors, got_per_floor - per_floor, seconds)
-        )
+        if refine is None:
+            parse = facade.parse_facade(rgb, net)
+        else:
+            weights = net if net is not None else facade.load_weights()
+            work = facade.working_image(rgb)
+            prob = facade.window_probability(work, weights)
+            parse = facade.parse_probability(rgb, work, prob, weights, refine=refine)
+        rows.append(measure(parse, photo, time.perf_counter() - start))
     return rows
+
+
+def measure(parse, photo: Path, seconds: float = 0.0) -> tuple:
+    """The row of :func:`evaluate` of a parse of ``photo`` (its labels and boxes beside it)."""
+    labels = np.asarray(Image.open(photo.with_suffix(".png")))
+    floors, per_floor = truth_grid(photo.with_suffix(".xml").read_text())
+    counts = parse.windows_per_floor()
+    got_per_floor = int(statistics.median(counts or [0]))
+    accuracy, tp, fp, fn = scores(parse.label_map(), labels)
+    return (accuracy, tp, fp, fn, len(counts) - floors, got_per_floor - per_floor, seconds)
 
 
 def summary(part: list[tuple]) -> str:
@@ -104,13 +115,16 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--cmp", type=Path, default=CMP)
     ap.add_argument("--limit", type=int, default=0, help="the first N façades only")
+    ap.add_argument(
+        "--no-refine", action="store_true", help="without section 5.2's boundary refinement"
+    )
     args = ap.parse_args()
     photos = sorted(args.cmp.glob("cmp_b*.jpg"))
     if args.limit:
         photos = photos[: args.limit]
     if not photos:
         sys.exit(f"{args.cmp}: no CMP façades here")
-    rows = evaluate(photos)
+    rows = evaluate(photos, refine=False if args.no_refine else None)
     print(f"all {len(rows)} (the shipped weights, trained on all of them): {summary(rows)}")
 
 

@@ -8,8 +8,15 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from bgr.inverse.image.facade import parse_facade, rows_of, runs, window_grid
-from bgr.inverse.image.pixels import WEIGHTS, load_weights
+from bgr.inverse.image.facade import (
+    parse_facade,
+    refine_boundaries,
+    refine_grid,
+    rows_of,
+    runs,
+    window_grid,
+)
+from bgr.inverse.image.pixels import WEIGHTS, load_weights, pitch
 
 ROOT = Path(__file__).resolve().parent.parent
 CMP = ROOT.parent / "shared/data/facades/cmp"
@@ -55,6 +62,39 @@ def test_the_grid_of_a_window_mask_is_its_floors_and_windows():
     grid = window_grid(mask)
     assert [len(floor) for floor in grid] == [3, 3, 3]
     assert grid[1][2] == (40, 90, 52, 110)
+
+
+def test_refined_boundaries_are_the_profiles_minima_near_them():
+    profile = np.ones(80)
+    profile[[10, 30, 50]] = 0
+    assert refine_boundaries(profile, [11, 29, 52], 20).tolist() == [10, 30, 50]
+
+
+def test_refined_boundaries_keep_the_spacing_within_75_to_140_percent():
+    """Section 5.2: the deepest minima near 50 and 78 are 18 apart, under 75 % of 40; the pair
+    kept is the best one 30 to 56 apart."""
+    profile = np.ones(120)
+    profile[[55, 73]] = 0
+    profile[[45, 83]] = 0.2
+    assert refine_boundaries(profile, [50, 78], 40).tolist() == [45, 83]
+
+
+def test_a_window_a_mullion_splits_is_one_window_of_its_tile():
+    """The refined grid has one window a tile (section 5.2): the two halves of a window whose
+    floor's other windows, and the floors above and below, have it whole are one window."""
+    grid = [[(10, 10, 20, 30), (10, 50, 20, 70)] for _ in range(3)]
+    grid[1] = [(40, 10, 50, 18), (40, 22, 50, 30), (40, 50, 50, 70)]
+    grid[2] = [(70, 10, 80, 30), (70, 50, 80, 70)]
+    v, h = np.ones(100), np.ones(90)
+    refined, bounds = refine_grid(grid, v, h)
+    assert [len(f) for f in refined] == [2, 2, 2]
+    assert refined[1][0] == (40, 10, 50, 30)
+    assert len(bounds) == 2 and 20 < bounds[0] < 40 < bounds[1] < 70
+
+
+def test_the_pitch_of_a_periodic_profile_is_its_period():
+    profile = np.tile([0, 0, 1, 1, 1, 0, 0, 0, 0, 0, 0, 0], 8).astype(float)
+    assert pitch(profile, 4, 48) == 12
 
 
 @pytest.mark.parametrize(("floors", "columns"), [(3, 4), (5, 2), (4, 6)])

@@ -5,17 +5,23 @@ The paper's stages, and what stands in for its CNNs here (each a documented devi
 measured on the CMP façades by ``bench/facade_cmp.py`` and ``bench/train_facade.py``):
 
 1. **Window evidence.**  The paper's window existence and window box CNNs run on each tile of a
-   grid its floor / column CNN proposes.  Here a small per-pixel perceptron
-   (:mod:`.pixels`, trained on CMP) gives each pixel's window probability, the gradient
-   projections of section 5.2 (``V(y) = sum_x |dI/dx|``, ``H(x) = sum_y |dI/dy|``) among its
-   features; pixels above its threshold are window.
+   grid its floor / column CNN proposes.  Here two small per-pixel perceptrons
+   (:mod:`.pixels`, trained on CMP; the second sees the first's map round the pixel) give each
+   pixel's window probability, the gradient projections of section 5.2
+   (``V(y) = sum_x |dI/dx|``, ``H(x) = sum_y |dI/dy|``) among the features; pixels above the
+   threshold are window.
 2. **Grid** (:func:`window_grid`), read off that window map as section 5.2 reads the gradient
    projections: floors are the runs of rows with many window pixels, and in each floor the
    windows are the runs of columns with window pixels in most of its rows; so every window is a
-   box and the boxes make the label map (the paper's simplified façade image).  Floor
-   boundaries lie midway between window rows.  Not yet: the paper's refinement of the
-   boundaries on the minima of V and H within 75 %-140 % of the estimate, the regularisation
-   of window sizes per floor, and the façade and window style recognition.
+   box and the boxes make the label map (the paper's simplified façade image).  Then section
+   5.2's refinement, as the paper states it (:func:`refine_grid`): the grid's floor count and
+   storey height, column count and window pitch stand for the CNN's estimates, and the
+   boundaries between floors and between columns move to the minima of V and H, each storey
+   and tile kept within 75 %-140 % of the estimate; each window belongs to the floor and tile
+   its centre is in, one window a tile.  (The paper's boundaries then cut the tiles its window
+   CNNs look into; here the windows are found first, so the refined boundaries regroup them and
+   are the floor boundaries of the parse.)  Not yet: the regularisation of window sizes per
+   floor, and the façade and window style recognition.
 3. **Façade colour** (section 5.4, as stated): k-means with k = 10 in L*a*b* on the pixels
    outside the windows; the largest cluster's centre.
 """
@@ -47,6 +53,14 @@ SLIVER = 0.35
 COLUMN_LEVEL = 0.5
 """In a floor's band, a column is a window's when at least this share of the band's rows are
 window pixels there (likewise a default)."""
+
+SPACING = (0.75, 1.40)
+"""Section 5.2: the refined floor heights and tile widths stay within 75 % and 140 % of the
+estimated ones."""
+
+REFINE = True
+"""Whether :func:`parse_facade` refines the grid on the gradient projections (section 5.2);
+``bench/facade_cmp.py --no-refine`` measures the parse without."""
 
 COLOR_CLUSTERS = 10  # section 5.4: "k = 10 clusters for all our results"
 
@@ -176,17 +190,110 @@ def window_grid(
     return [f for f in floors if f]
 
 
+def refine_boundaries(
+    profile: np.ndarray, bounds: list[int], spacing: float, within: tuple[float, float] = SPACING
+) -> np.ndarray:
+    """Section 5.2's refinement: the boundaries ``bounds`` (increasing indices into
+    ``profile``) each displaced by at most half of (1 - 0.75) of ``spacing`` to where the sum of
+    ``profile`` over them is least, every gap between neighbours kept within ``within`` of
+    ``spacing``: exactly, by dynamic programming along the chain.  Where two neighbours cannot
+    be kept within it (the estimate is off there) that gap is left free."""
+    n = len(profile)
+    if not bounds or spacing <= 0:
+        return np.asarray(bounds, dtype=np.float64)
+    low, high = within[0] * spacing, within[1] * spacing
+    reach = max(1, round((1 - within[0]) * spacing / 2))
+    cands = [np.arange(max(1, b - reach), min(n - 1, b + reach) + 1) for b in bounds]
+    cost = profile[cands[0]].astype(np.float64)
+    back = []
+    for j in range(1, len(cands)):
+        gap = cands[j][:, None] - cands[j - 1][None, :]
+        total = np.where((gap >= low) & (gap <= high), cost[None, :], np.inf)
+        if not np.isfinite(total).any():
+            total = np.where(gap > 0, cost[None, :], np.inf)
+        best = total.argmin(axis=1)
+        back.append(best)
+        cost = profile[cands[j]] + total[np.arange(len(cands[j])), best]
+    k = int(np.argmin(cost))
+    out = [int(cands[-1][k])]
+    for j in range(len(cands) - 1, 0, -1):
+        k = int(back[j - 1][k])
+        out.append(int(cands[j - 1][k]))
+    return np.array(out[::-1], dtype=np.float64)
+
+
+def refine_grid(
+    grid: list[list[tuple[int, int, int, int]]], v: np.ndarray, h: np.ndarray
+) -> tuple[list[list[tuple[int, int, int, int]]], np.ndarray]:
+    """The grid of :func:`window_grid` refined as section 5.2 refines its CNN's: the floor
+    count and storey height, the column count and window pitch, are the grid's (the paper's
+    estimates), the boundaries between floors (columns) start midway between the window rows
+    (columns of windows across the floors, grouped by :func:`rows_of`) and move to minima of
+    ``v`` = V(y) (``h`` = H(x)) by :func:`refine_boundaries`.  Each window then belongs to the
+    floor its centre lies in, and the windows of one floor whose centres share a column tile
+    become one (the paper's one window a tile: a mullion no longer splits a window in two).
+    Where this deviates from the paper's words: the estimates are medians of the grid's
+    spacings, not a CNN's; only the inner boundaries move, so the top and bottom storeys (to the
+    photograph's edges: roof, ground floor) are not held to the estimate; how far a boundary
+    may move, which the paper leaves open, is :func:`refine_boundaries`'s.  Returns the grid
+    and the inner floor boundaries (rows)."""
+    if not grid:
+        return grid, np.zeros(0)
+    tops = [float(np.median([w[0] for w in f])) for f in grid]
+    bottoms = [float(np.median([w[2] for w in f])) for f in grid]
+    inner = [round((b + t) / 2) for b, t in zip(bottoms[:-1], tops[1:], strict=True)]
+    centres = np.add(tops, bottoms) / 2
+    storey = float(np.median(np.diff(centres))) if len(grid) > 1 else 0.0
+    ys = refine_boundaries(v, inner, storey)
+    windows = [w for f in grid for w in f]
+    floor_of = np.searchsorted(ys, [(w[0] + w[2]) / 2 for w in windows])
+    extents = [(float(w[1]), float(w[3])) for w in windows]
+    columns = rows_of(extents)
+    tile_of = np.zeros(len(windows), dtype=np.int64)
+    if len(columns) > 1:
+        lefts = [float(np.median([extents[i][0] for i in c])) for c in columns]
+        rights = [float(np.median([extents[i][1] for i in c])) for c in columns]
+        mids = [round((r + left) / 2) for r, left in zip(rights[:-1], lefts[1:], strict=True)]
+        pitch = float(np.median(np.diff(np.add(lefts, rights) / 2)))
+        xs = refine_boundaries(h, sorted(mids), pitch)
+        tile_of = np.searchsorted(xs, [(w[1] + w[3]) / 2 for w in windows])
+    tiles: dict[tuple[int, int], tuple[int, int, int, int]] = {}
+    for w, f, c in zip(windows, floor_of, tile_of, strict=True):
+        key = (int(f), int(c))
+        a = tiles.get(key, w)
+        tiles[key] = (min(a[0], w[0]), min(a[1], w[1]), max(a[2], w[2]), max(a[3], w[3]))
+    kept = sorted({f for f, _ in tiles})
+    floors = [[tiles[f, c] for f, c in sorted(tiles) if f == k] for k in kept]
+    return floors, np.array([ys[k - 1] for k in kept[1:]])
+
+
 def parse_facade(rgb: np.ndarray, net: dict[str, np.ndarray] | None = None) -> FacadeParse:
     """The parse of a rectified façade photograph (h, w, 3) uint8 (``net``: the window
     classifier's weights, by default the shipped ones)."""
     net = net if net is not None else load_weights()
-    height, width = rgb.shape[:2]
     work = working_image(rgb)
-    prob = window_probability(work, net)
+    return parse_probability(rgb, work, window_probability(work, net), net)
+
+
+def parse_probability(
+    rgb: np.ndarray,
+    work: np.ndarray,
+    prob: np.ndarray,
+    net: dict[str, np.ndarray],
+    refine: bool = REFINE,
+    color: bool = True,
+) -> FacadeParse:
+    """The parse of ``rgb`` from the window probability ``prob`` of its working image ``work``
+    (apart from :func:`parse_facade` so that the training and the benchmark can try grid levels
+    and the refinement on one probability map; ``color=False`` skips the colour's k-means)."""
+    height, width = rgb.shape[:2]
     small = prob >= float(net["threshold"])
     levels = {k: float(net[k]) for k in ("row_level", "column_level") if k in net}
     grid = window_grid(small, **levels)
     sy, sx = height / work.shape[0], width / work.shape[1]
+    if refine:
+        v, h = gradient_projections(lab_image(work)[..., 0] / 100.0)
+        grid, inner = refine_grid(grid, v, h)
     windows = np.array(
         [(t * sy, x0 * sx, b * sy, x1 * sx) for floor in grid for t, x0, b, x1 in floor]
     ).reshape(-1, 4)
@@ -198,12 +305,13 @@ def parse_facade(rgb: np.ndarray, net: dict[str, np.ndarray] | None = None) -> F
     for floor in grid:
         floors.append(list(range(k, k + len(floor))))
         k += len(floor)
-    tops = [float(windows[f[0], 0]) for f in floors]
-    bottoms = [float(windows[f[0], 2]) for f in floors]
-    inner = [(b + t) / 2 for b, t in zip(bottoms[:-1], tops[1:], strict=True)]
-    bounds = np.array([0.0, *inner, float(height)])
-    color = facade_color(rgb, ~window)
-    return FacadeParse(window, windows, floors, bounds, color)
+    if not refine:  # floor boundaries midway between the window rows
+        tops = [float(np.median(windows[f, 0])) / sy for f in floors]
+        bottoms = [float(np.median(windows[f, 2])) / sy for f in floors]
+        inner = np.array([(b + t) / 2 for b, t in zip(bottoms[:-1], tops[1:], strict=True)])
+    bounds = np.array([0.0, *(inner * sy), float(height)])
+    rgb_color = facade_color(rgb, ~window) if color else (0, 0, 0)
+    return FacadeParse(window, windows, floors, bounds, rgb_color)
 
 
 def _lab(rgb: np.ndarray) -> np.ndarray:
