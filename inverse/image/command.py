@@ -122,10 +122,12 @@ def grid_values(parse: FacadeParse, floor_height: float) -> dict[str, float]:
     }
 
 
-def facade_grammar(parse: FacadeParse, source: str, floor_height: float) -> str:
+def facade_grammar(
+    parse: FacadeParse, source: str, floor_height: float, window: str = "Plain"
+) -> str:
     """The parse as a grammar: a slab the photograph's size (scaled so that the floors are
     ``floor_height`` metres apart) whose front is the stdlib's ``fac.Grid`` with the parse's
-    floors, tiles, windows and colour."""
+    floors, tiles, windows, colour and ``window`` rule (of stdlib.window)."""
     values = grid_values(parse, floor_height)
     counts = parse.windows_per_floor()
     color = "#{:02x}{:02x}{:02x}".format(*parse.color)
@@ -136,6 +138,7 @@ def facade_grammar(parse: FacadeParse, source: str, floor_height: float) -> str:
         "version 1",
         "",
         "import stdlib.facade as fac",
+        "import stdlib.window as win",
         "",
         *(f"attr {name} = {value:.3f}".rstrip("0").rstrip(".") for name, value in values.items()),
         f'attr wall_color = "{color}"',
@@ -143,7 +146,7 @@ def facade_grammar(parse: FacadeParse, source: str, floor_height: float) -> str:
         "Lot --> s(width, 0, 0.3) extrude(height) "
         "comp(f) { front: Facade | all: color(wall_color) }",
         "Facade --> fac.Grid(floor_h = floor_h, tile_w = tile_w, win_w = win_w, win_h = win_h, "
-        "sill_h = sill_h, margin = margin, wall_color = wall_color)",
+        f"sill_h = sill_h, margin = margin, wall_color = wall_color, window = win.{window})",
     ]
     from bgr.grammar.formatter import format_source
 
@@ -167,8 +170,12 @@ def run_facade(args) -> int:
     for target in (args.output, args.label_map):
         if target not in (None, "-"):
             check_output(target)
-    parse = parse_facade(read_photo(args.input))
-    text = facade_grammar(parse, args.input, args.floor_height)
+    from .windows import window_style
+
+    photo = read_photo(args.input)
+    parse = parse_facade(photo)
+    window, _ = window_style(photo, parse.windows)
+    text = facade_grammar(parse, args.input, args.floor_height, window)
     if args.label_map:
         labels = Image.fromarray(parse.label_map(), mode="P")
         labels.putpalette(PALETTE)
@@ -181,7 +188,8 @@ def run_facade(args) -> int:
     counts = parse.windows_per_floor()
     print(
         f"{terminal_text(args.input, keep='')}: {len(counts)} floors, "
-        f"{sum(counts)} windows, façade colour #{'{:02x}{:02x}{:02x}'.format(*parse.color)}",
+        f"{sum(counts)} windows of win.{window}, façade colour "
+        f"#{'{:02x}{:02x}{:02x}'.format(*parse.color)}",
         file=sys.stderr,
     )
     return 0

@@ -43,6 +43,7 @@ class PhotoFit:
     scale: float
     parse: FacadeParse | None
     facade_size: tuple[float, float]  # the rectified façade's width and height, model units
+    window: str = "Plain"  # the stdlib window rule voted on the façade's windows
 
 
 def fitting_size(width: int, height: int) -> tuple[int, int]:
@@ -112,8 +113,8 @@ def facade_quads(fit: MassFit, width: int, height: int) -> list[tuple[float, np.
 
 def read_facade(rgb: np.ndarray, fit: MassFit, mirrored: bool, progress=None):
     """The largest visible façade rectified and parsed: (parse or None, its size in model
-    units).  None when no face is visible or the rectification fails (the grammar then keeps
-    the stdlib's default façade)."""
+    units, the rectified image or None).  None when no face is visible or the rectification
+    fails (the grammar then keeps the stdlib's default façade)."""
     from .rectify import rectify_facade, refine_quad
 
     height, width = rgb.shape[:2]
@@ -128,15 +129,15 @@ def read_facade(rgb: np.ndarray, fit: MassFit, mirrored: bool, progress=None):
         except ValueError as exc:
             if progress:
                 progress(f"  façade not rectified: {exc}")
-            return None, size
+            return None, size, None
         image = rect.image[:, ::-1] if mirrored else rect.image
         if progress:
             progress(
                 f"  rectified {size[0]:.1f} x {size[1]:.1f} units to "
                 f"{image.shape[1]}x{image.shape[0]} px"
             )
-        return parse_facade(image), size
-    return None, (0.0, 0.0)
+        return parse_facade(image), size, image
+    return None, (0.0, 0.0), None
 
 
 def fit_photo(
@@ -156,7 +157,13 @@ def fit_photo(
             f"{fit.distance:.2f} px, {time.perf_counter() - start:.1f} s"
         )
     start = time.perf_counter()
-    parse, size = read_facade(rgb, fit, mirrored, progress)
+    parse, size, image = read_facade(rgb, fit, mirrored, progress)
+    window = "Plain"
+    votes: dict[str, int] = {}
+    if parse is not None and image is not None and len(parse.windows):
+        from .windows import window_style
+
+        window, votes = window_style(image, parse.windows)
     scale = 1.0
     if parse is not None and len(parse.floors) >= 1 and size[1] > 0:
         # the façade's floors are floor_height metres apart
@@ -165,10 +172,11 @@ def fit_photo(
     if progress:
         floors = len(parse.floors) if parse is not None else 0
         progress(
-            f"façade: {floors} floors, scale {scale:.2f} m per unit, "
+            f"façade: {floors} floors, windows win.{window} ({votes.get(window, 0)} of "
+            f"{sum(votes.values())} votes), scale {scale:.2f} m per unit, "
             f"{time.perf_counter() - start:.1f} s"
         )
-    return PhotoFit(fit, mirrored, scale, parse, size)
+    return PhotoFit(fit, mirrored, scale, parse, size, window)
 
 
 def photo_grammar(result: PhotoFit, source: str, floor_height: float) -> str:
@@ -191,6 +199,7 @@ def photo_grammar(result: PhotoFit, source: str, floor_height: float) -> str:
         "",
         "import stdlib.mass as mass",
         "import stdlib.facade as fac",
+        "import stdlib.window as win",
         "",
         *attr_lines(family, values),
     ]
@@ -206,7 +215,8 @@ def photo_grammar(result: PhotoFit, source: str, floor_height: float) -> str:
     if facade == "Facade":
         lines.append(
             "Facade --> fac.Grid(floor_h = floor_h, tile_w = tile_w, win_w = win_w, "
-            "win_h = win_h, sill_h = sill_h, margin = margin, wall_color = wall_color)"
+            "win_h = win_h, sill_h = sill_h, margin = margin, wall_color = wall_color, "
+            f"window = win.{result.window})"
         )
     return format_source("\n".join(lines) + "\n")
 
