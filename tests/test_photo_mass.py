@@ -8,7 +8,7 @@ import pytest
 
 from bgr.inverse.image import camera as cam
 from bgr.inverse.image.camera import PhotoCamera
-from bgr.inverse.image.mass_fit import MassFit, estimate, refine
+from bgr.inverse.image.mass_fit import MassFit, _conv, _pool, estimate, refine
 from bgr.inverse.image.masses import BY_RULE, FAMILIES, side_faces, triangles
 from bgr.inverse.image.outline import Target, boundary, iou
 
@@ -105,3 +105,23 @@ def test_the_network_ranks_the_true_family_high_on_clear_silhouettes():
         hits += rule in [g.family.rule for g in guesses]
         assert all(0 <= g.probability <= 1 for g in guesses)
     assert hits >= 4
+
+
+@pytest.mark.parametrize(("k", "stride"), [(5, 2), (3, 1)])
+def test_the_numpy_convolution_is_torchs_same_padded_convolution(k, stride):
+    """The shipped network was trained in PyTorch and runs in numpy: each output pixel is the
+    sum over channels and the k x k window round ``stride``-th input pixels, zeros outside."""
+    rng = np.random.default_rng(5)
+    x = rng.normal(size=(2, 3, 8, 8)).astype(np.float32)
+    w = rng.normal(size=(4, 3, k, k)).astype(np.float32)
+    b = rng.normal(size=4).astype(np.float32)
+    out = _conv(x, w, b, stride)
+    pad = k // 2
+    padded = np.pad(x, ((0, 0), (0, 0), (pad, pad), (pad, pad)))
+    side = -(-8 // stride)
+    assert out.shape == (2, 4, side, side)
+    for n, o, i, j in [(0, 0, 0, 0), (1, 3, side - 1, side - 1), (0, 2, 1, side - 2)]:
+        window = padded[n, :, i * stride : i * stride + k, j * stride : j * stride + k]
+        assert out[n, o, i, j] == pytest.approx(float((window * w[o]).sum() + b[o]), abs=1e-4)
+    pooled = _pool(out)
+    assert pooled[1, 3, 0, 0] == out[1, 3, :2, :2].max()

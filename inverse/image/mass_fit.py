@@ -3,11 +3,13 @@ recognises the mass family among the 30 stdlib masses and estimates the camera's
 parameters jointly from the silhouette; a bound-constrained derivative-free search then refines
 them on the paper's distance between silhouettes.
 
-The network is a multilayer perceptron over the silhouette drawn at :data:`INPUT` pixels (the
-paper's CNNs read 227 x 227 images; see docs/inverse-image.md for what was measured), with one
-shared body and three heads: the family (softmax), the camera's eight parameters, and every
-family's mass parameters (only the true family's head is trained on a sample).  Its weights are
-``mass_net.npz``, trained by ``bench/train_mass.py`` on silhouettes the project renders itself.
+The network is a small convolutional network over the silhouette cropped round its box at
+:data:`CROP` pixels, plus the box itself (the paper's AlexNets read 227 x 227 images; see
+docs/inverse-image.md for what was measured): four 3 x 3 / 5 x 5 convolutions with ReLU and max
+pooling, one fully connected layer, and three heads: the family (softmax), the camera's eight
+parameters, and every family's mass parameters (only the true family's head is trained on a
+sample).  Its weights are ``mass_net.npz``, trained by ``bench/train_mass.py`` (PyTorch, a
+training-only extra) on silhouettes the project renders itself; it runs here in numpy.
 """
 
 from __future__ import annotations
@@ -24,7 +26,7 @@ from .camera import PhotoCamera
 from .masses import FAMILIES, MAX_PARAMS, Family, triangles
 from .outline import AREA_WEIGHT, Target, centre, silhouette
 
-CROP = 48  # side of the square crop round the silhouette the network reads, pixels
+CROP = 64  # side of the square crop round the silhouette the network reads, pixels
 CANVAS = (320, 240)  # a photograph is first stretched to 4:3, as the synthetic ones are
 FEATURES = CROP * CROP + 4
 WEIGHTS = Path(__file__).with_name("mass_net.npz")
@@ -57,12 +59,40 @@ def load_weights() -> dict[str, np.ndarray]:
         return {k: data[k] for k in data.files}
 
 
+def _conv(x: np.ndarray, weight: np.ndarray, bias: np.ndarray, stride: int) -> np.ndarray:
+    """A 'same'-padded 2-D convolution of (n, c, h, w) by (o, c, k, k) weights, as
+    ``torch.nn.Conv2d(padding=k // 2, stride=stride)`` computes it."""
+    k = weight.shape[-1]
+    pad = k // 2
+    padded = np.pad(x, ((0, 0), (0, 0), (pad, pad), (pad, pad)))
+    windows = np.lib.stride_tricks.sliding_window_view(padded, (k, k), axis=(2, 3))
+    windows = windows[:, :, : x.shape[2] : stride, : x.shape[3] : stride]
+    out = np.tensordot(windows, weight, axes=([1, 4, 5], [1, 2, 3]))  # (n, h, w, o)
+    return out.transpose(0, 3, 1, 2) + bias[None, :, None, None]
+
+
+def _relu(x: np.ndarray) -> np.ndarray:
+    return np.maximum(x, 0)
+
+
+def _pool(x: np.ndarray) -> np.ndarray:
+    """2 x 2 max pooling of (n, c, h, w), h and w even."""
+    n, c, h, w = x.shape
+    return x.reshape(n, c, h // 2, 2, w // 2, 2).max(axis=(3, 5))
+
+
 def forward(net: dict[str, np.ndarray], x: np.ndarray) -> tuple[np.ndarray, ...]:
-    """(family logits (n, F), camera (n, 8), mass (n, F, MAX_PARAMS)) in [0, 1] units."""
-    z = (x - net["mean"]) / net["std"]
-    hidden = np.maximum(z @ net["w1"] + net["b1"], 0)
-    hidden = np.maximum(hidden @ net["w2"] + net["b2"], 0)
-    out = hidden @ net["w3"] + net["b3"]
+    """(family logits (n, F), camera (n, 8), mass (n, F, MAX_PARAMS)) in [0, 1] units, of
+    (n, FEATURES) network inputs."""
+    image = x[:, : CROP * CROP].reshape(-1, 1, CROP, CROP).astype(np.float32) - 0.5
+    box = (x[:, CROP * CROP :] - net["box_mean"]) / net["box_std"]
+    h = _relu(_conv(image, net["c1_weight"], net["c1_bias"], 2))
+    h = _pool(_relu(_conv(h, net["c2_weight"], net["c2_bias"], 1)))
+    h = _pool(_relu(_conv(h, net["c3_weight"], net["c3_bias"], 1)))
+    h = _pool(_relu(_conv(h, net["c4_weight"], net["c4_bias"], 1)))
+    flat = np.concatenate([h.reshape(len(x), -1), box], axis=1)
+    hidden = _relu(flat @ net["f1_weight"].T + net["f1_bias"])
+    out = hidden @ net["f2_weight"].T + net["f2_bias"]
     n = len(FAMILIES)
     logits = out[:, :n]
     camera = out[:, n : n + 8]

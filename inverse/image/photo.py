@@ -51,12 +51,18 @@ def fitting_size(width: int, height: int) -> tuple[int, int]:
     return max(8, round(width * k)), max(8, round(height * k))
 
 
-def fit_mass(mask: np.ndarray, progress=None) -> tuple[MassFit, bool]:
+def fit_mass(
+    mask: np.ndarray, progress=None, network_mask: np.ndarray | None = None
+) -> tuple[MassFit, bool]:
     """The best mass and camera for a silhouette mask (already at the fitting size), and
-    whether it was found on the mirrored silhouette."""
+    whether it was found on the mirrored silhouette.  ``network_mask`` is the same silhouette
+    at a finer size for the network, which was trained on silhouettes drawn at
+    ``mass_fit.CANVAS`` (on the fitting size's coarser ones its family top-1 falls from 0.76
+    to 0.69: docs/benchmarks.md)."""
+    network_mask = mask if network_mask is None else network_mask
     options = []
     for mirrored in (False, True):
-        seen = mask[:, ::-1] if mirrored else mask
+        seen = network_mask[:, ::-1] if mirrored else network_mask
         for guess in estimate(seen, top=CANDIDATES):
             options.append((guess, mirrored))
     # the network's likeliest guesses of both orientations, their cameras refined; the closest
@@ -150,7 +156,7 @@ def fit_photo(
 
     mask = np.asarray(Image.fromarray(mask_full).resize(small, Image.Resampling.NEAREST))
     start = time.perf_counter()
-    fit, mirrored = fit_mass(mask, progress)
+    fit, mirrored = fit_mass(mask, progress, network_mask=mask_full)
     if progress:
         progress(
             f"mass: {fit.family.rule}{' (mirrored)' if mirrored else ''}, distance "
