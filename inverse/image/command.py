@@ -1,5 +1,6 @@
 """``bgr infer FACADE.jpg --kind facade -o f.bgr [--label-map L.png]``: a rectified façade
-photograph parsed (:mod:`.facade`) and written as a grammar of the stdlib's ``fac.Grid``."""
+photograph parsed (:mod:`.facade`) and written as a grammar of the stdlib's façade it is likeliest
+to be (:mod:`.facade_style`; ``fac.Grid`` when unsure)."""
 
 from __future__ import annotations
 
@@ -123,14 +124,22 @@ def grid_values(parse: FacadeParse, floor_height: float) -> dict[str, float]:
 
 
 def facade_grammar(
-    parse: FacadeParse, source: str, floor_height: float, window: str = "Plain"
+    parse: FacadeParse,
+    source: str,
+    floor_height: float,
+    window: str = "Plain",
+    style: tuple[str, dict[str, float]] | None = None,
 ) -> str:
     """The parse as a grammar: a slab the photograph's size (scaled so that the floors are
-    ``floor_height`` metres apart) whose front is the stdlib's ``fac.Grid`` with the parse's
-    floors, tiles, windows, colour and ``window`` rule (of stdlib.window)."""
-    values = grid_values(parse, floor_height)
+    ``floor_height`` metres apart) whose front is the stdlib façade ``style`` = (rule, its
+    fitted parameters, :func:`.facade_style.facade_style`), by default ``fac.Grid`` with the
+    parse's floors, tiles and windows; with the parse's colour and ``window`` rule (of
+    stdlib.window)."""
+    from .facade_style import facade_call
+
+    rule, values = style if style is not None else ("Grid", grid_values(parse, floor_height))
     counts = parse.windows_per_floor()
-    color = "#{:02x}{:02x}{:02x}".format(*parse.color)
+    attrs, call = facade_call(rule, values, parse.color, window)
     lines = [
         f"# {_comment(Path(source).name)}: a façade parsed by bgr infer --kind facade, "
         f"{len(counts)} floors of {', '.join(map(str, counts)) or 'no'} windows",
@@ -140,13 +149,12 @@ def facade_grammar(
         "import stdlib.facade as fac",
         "import stdlib.window as win",
         "",
-        *(f"attr {name} = {value:.3f}".rstrip("0").rstrip(".") for name, value in values.items()),
-        f'attr wall_color = "{color}"',
+        *(f"attr {k} = {values[k]:.3f}".rstrip("0").rstrip(".") for k in ("width", "height")),
+        *attrs,
         "",
         "Lot --> s(width, 0, 0.3) extrude(height) "
         "comp(f) { front: Facade | all: color(wall_color) }",
-        "Facade --> fac.Grid(floor_h = floor_h, tile_w = tile_w, win_w = win_w, win_h = win_h, "
-        f"sill_h = sill_h, margin = margin, wall_color = wall_color, window = win.{window})",
+        f"Facade --> {call}",
     ]
     from bgr.grammar.formatter import format_source
 
@@ -170,12 +178,14 @@ def run_facade(args) -> int:
     for target in (args.output, args.label_map):
         if target not in (None, "-"):
             check_output(target)
+    from .facade_style import describe, facade_style
     from .windows import window_style
 
     photo = read_photo(args.input)
     parse = parse_facade(photo)
     window, _ = window_style(photo, parse.windows)
-    text = facade_grammar(parse, args.input, args.floor_height, window)
+    rule, values, proba = facade_style(parse, photo, args.floor_height)
+    text = facade_grammar(parse, args.input, args.floor_height, window, (rule, values))
     if args.label_map:
         labels = Image.fromarray(parse.label_map(), mode="P")
         labels.putpalette(PALETTE)
@@ -188,7 +198,7 @@ def run_facade(args) -> int:
     counts = parse.windows_per_floor()
     print(
         f"{terminal_text(args.input, keep='')}: {len(counts)} floors, "
-        f"{sum(counts)} windows of win.{window}, façade colour "
+        f"{sum(counts)} windows of win.{window}, façade {describe(rule, proba)}, colour "
         f"#{'{:02x}{:02x}{:02x}'.format(*parse.color)}",
         file=sys.stderr,
     )

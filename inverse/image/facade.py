@@ -21,7 +21,7 @@ measured on the CMP façades by ``bench/facade_cmp.py`` and ``bench/train_facade
    its centre is in, one window a tile.  (The paper's boundaries then cut the tiles its window
    CNNs look into; here the windows are found first, so the refined boundaries regroup them and
    are the floor boundaries of the parse.)  Not yet: the regularisation of window sizes per
-   floor, and the façade and window style recognition.
+   floor.  (The window and façade styles: :mod:`.windows`, :mod:`.facade_style`.)
 3. **Façade colour** (section 5.4, as stated): k-means with k = 10 in L*a*b* on the pixels
    outside the windows; the largest cluster's centre.
 """

@@ -44,6 +44,7 @@ class PhotoFit:
     parse: FacadeParse | None
     facade_size: tuple[float, float]  # the rectified façade's width and height, model units
     window: str = "Plain"  # the stdlib window rule voted on the façade's windows
+    style: tuple[str, dict[str, float]] | None = None  # the façade rule and its fitted values
 
 
 def fitting_size(width: int, height: int) -> tuple[int, int]:
@@ -175,19 +176,28 @@ def fit_photo(
         # the façade's floors are floor_height metres apart
         units_per_floor = size[1] / max(1, len(parse.floors))
         scale = floor_height / units_per_floor
+    from .facade_style import describe, facade_style
+
+    style = None
+    rule = "Grid"
+    proba: dict[str, float] = {}
+    if parse is not None and image is not None and len(parse.windows):
+        rule, values, proba = facade_style(parse, image, floor_height)
+        style = (rule, values)
     if progress:
         floors = len(parse.floors) if parse is not None else 0
         progress(
-            f"façade: {floors} floors, windows win.{window} ({votes.get(window, 0)} of "
-            f"{sum(votes.values())} votes), scale {scale:.2f} m per unit, "
-            f"{time.perf_counter() - start:.1f} s"
+            f"façade: {floors} floors, {describe(rule, proba)}, windows win.{window} "
+            f"({votes.get(window, 0)} of {sum(votes.values())} votes), scale {scale:.2f} m per "
+            f"unit, {time.perf_counter() - start:.1f} s"
         )
-    return PhotoFit(fit, mirrored, scale, parse, size, window)
+    return PhotoFit(fit, mirrored, scale, parse, size, window, style)
 
 
 def photo_grammar(result: PhotoFit, source: str, floor_height: float) -> str:
     """The fit as one grammar: the mass's parameters and the façade's as attrs, the mass rule
-    of stdlib.mass with the stdlib's fac.Grid on every side."""
+    of stdlib.mass with the stdlib façade recognised on the photograph (:mod:`.facade_style`,
+    fac.Grid when unsure or without a parse) on every side."""
     from bgr.grammar.formatter import format_source
 
     from .command import grid_values
@@ -211,19 +221,15 @@ def photo_grammar(result: PhotoFit, source: str, floor_height: float) -> str:
     ]
     facade = "fac.Grid"
     if result.parse is not None and len(result.parse.windows):
-        grid = grid_values(result.parse, floor_height)
-        color = "#{:02x}{:02x}{:02x}".format(*result.parse.color)
-        for name in ("floor_h", "tile_w", "win_w", "win_h", "sill_h", "margin"):
-            lines.append(f"attr {name} = {grid[name]:.3f}".rstrip("0").rstrip("."))
-        lines.append(f'attr wall_color = "{color}"')
+        from .facade_style import facade_call
+
+        rule, values = result.style or ("Grid", grid_values(result.parse, floor_height))
+        attrs, call = facade_call(rule, values, result.parse.color, result.window)
+        lines += attrs
         facade = "Facade"
     lines += ["", f"Lot --> {family.call(facade)}"]
     if facade == "Facade":
-        lines.append(
-            "Facade --> fac.Grid(floor_h = floor_h, tile_w = tile_w, win_w = win_w, "
-            "win_h = win_h, sill_h = sill_h, margin = margin, wall_color = wall_color, "
-            f"window = win.{result.window})"
-        )
+        lines.append(f"Facade --> {call}")
     return format_source("\n".join(lines) + "\n")
 
 
