@@ -39,8 +39,11 @@ class View:
     corners: np.ndarray  # (n, 3, 2) projected triangles, x / width and y / height
 
 
-def views_of(family: int, rng: np.random.Generator, count: int) -> list[View]:
-    """Up to ``count`` accepted views of one random mass of a family."""
+def views_of(
+    family: int, rng: np.random.Generator, count: int, jitter: float = JITTER
+) -> list[View]:
+    """Up to ``count`` accepted views of one random mass of a family, the outline's corners
+    moved by up to ``jitter`` (0: a clean render of the same mass and camera)."""
     fam = FAMILIES[family]
     unit = rng.random(len(fam.params))
     tris = triangles(fam, fam.values(unit))
@@ -63,7 +66,9 @@ def views_of(family: int, rng: np.random.Generator, count: int) -> list[View]:
         xy = pixels / np.array([width, height])
         if (xy < -OUTSIDE).any() or (xy > 1 + OUTSIDE).any():
             continue
-        xy = xy + rng.uniform(-JITTER, JITTER, xy.shape)
+        # drawn whatever the jitter, so that a clean set has the jittered set's masses and views
+        moved = rng.uniform(-JITTER, JITTER, xy.shape)
+        xy = xy + moved * (jitter / JITTER)
         found.append(View(family, unit, cam_unit, xy[inverse.reshape(-1)].reshape(-1, 3, 2)))
     return found
 
@@ -94,12 +99,12 @@ def draw_view(view: View, width: int, height: int) -> np.ndarray:
     return draw(view.corners * np.array([width, height]), width, height)
 
 
-def sample(seed: int, per_family: int, views: int) -> list[View]:
+def sample(seed: int, per_family: int, views: int, jitter: float = JITTER) -> list[View]:
     """``per_family`` masses of every family, ``views`` accepted views of each (fewer when the
     camera draws run out), from one seed."""
     rng = np.random.default_rng(seed)
     out: list[View] = []
     for family in range(len(FAMILIES)):
         for _ in range(per_family):
-            out += views_of(family, rng, views)
+            out += views_of(family, rng, views, jitter)
     return out

@@ -47,14 +47,13 @@ Shopfront 10, Portal 8, and four or fewer each of ten others.
 from __future__ import annotations
 
 import statistics
-from functools import lru_cache
 from pathlib import Path
 
 import numpy as np
 from PIL import Image
 
 from .facade import FacadeParse, rows_of
-from .windows import predict_proba
+from .windows import load_weights, predict_proba
 
 WEIGHTS = Path(__file__).with_name("facade_styles.npz")
 
@@ -279,19 +278,11 @@ def features(parse: FacadeParse, rgb: np.ndarray) -> np.ndarray:
     return np.concatenate([layout_features(parse), image_features(parse, rgb)]).astype(np.float32)
 
 
-@lru_cache(maxsize=2)
-def _load(path: str) -> tuple[dict[str, np.ndarray], tuple[str, ...]]:
-    with np.load(path, allow_pickle=False) as data:
-        net = {key: np.asarray(data[key], dtype=np.float64) for key in data.files if key != "rules"}
-        rules = tuple(str(r) for r in data["rules"])
-    return net, rules
-
-
 def classify(
     parse: FacadeParse, rgb: np.ndarray, weights: str | Path = WEIGHTS
 ) -> dict[str, float]:
     """Each family's probability, likeliest first."""
-    net, rules = _load(str(weights))
+    net, rules = load_weights(weights)  # the windows' perceptron file format
     p = predict_proba(features(parse, rgb)[None], net)[0]
     order = np.argsort(-p, kind="stable")
     return {rules[i]: float(p[i]) for i in order}

@@ -58,8 +58,8 @@ def fit_mass(
     """The best mass and camera for a silhouette mask (already at the fitting size), and
     whether it was found on the mirrored silhouette.  ``network_mask`` is the same silhouette
     at a finer size for the network, which was trained on silhouettes drawn at
-    ``mass_fit.CANVAS`` (on the fitting size's coarser ones its family top-1 falls from 0.76
-    to 0.69: docs/benchmarks.md)."""
+    ``mass_fit.CANVAS`` (on the fitting size's coarser ones its family top-1 falls from 0.75
+    to 0.67: docs/inverse-image.md)."""
     network_mask = mask if network_mask is None else network_mask
     options = []
     for mirrored in (False, True):

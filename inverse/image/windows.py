@@ -212,7 +212,8 @@ def _load(path: str) -> tuple[dict[str, np.ndarray], tuple[str, ...]]:
 def load_weights(
     path: str | Path = WEIGHTS,
 ) -> tuple[dict[str, np.ndarray], tuple[str, ...]]:
-    """(net, rule names) from a weights file written by ``bench/train_windows.py``."""
+    """(net, rule names) from a weights file written by ``bench/train_windows.py`` (or
+    ``bench/train_facade_style.py``: the same perceptron)."""
     return _load(str(path))
 
 
