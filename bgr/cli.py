@@ -746,7 +746,7 @@ def cmd_derive(args) -> int:
             seed=args.seed,
             attrs=job.values,
             fmt=fmt,
-            site=site_of(lots),
+            site=site_of(lots, grammar),
             grammar=str(grammar.path or ""),
             gltf={"group_by": args.group_by, "instancing": "auto" if args.instancing else False},
             lot_origins=np.array([lot.shape.origin for lot in lots]),

@@ -45,6 +45,7 @@ from bgr.interpreter.terminals import TerminalTable, lot_tables
 from .gltf_materials import MaterialIndex, UvSets, image_members
 from .instancing import CORNER_BYTES, INSTANCE_BYTES, plan, quaternions
 from .meshes import MeshPool, bounds, face_offsets, place_corners, unit_normals
+from .placement import gltf_translation
 from .terminal_json import plain
 
 INSTANCING = "EXT_mesh_gpu_instancing"
@@ -246,8 +247,11 @@ class Scene:
         self.image_views: list[tuple[int, str]] = []  # per image: (bufferView, mimeType)
         self.image_alpha: dict[str, bool] = {}
         self.root: dict = {"name": "bgr", "children": []}
-        if self.shift.any():
-            self.root["translation"] = self.shift.tolist()
+        # the recentring shift, and the site's origin: a reader applying the root's transform
+        # sees the input's coordinates (formats/placement.py)
+        translation = self.shift + gltf_translation(site)
+        if translation.any():
+            self.root["translation"] = translation.tolist()
         meta = TerminalTable(site=site, grammar=grammar)
         self.root["extras"] = root_extras(meta, seed, attrs)
         self.spools = {k: _Spool(folder) for k in ("nodes", "meshes", "accessors", "views")}
@@ -533,7 +537,10 @@ def root_extras(table: TerminalTable, seed: int, attrs: dict) -> dict:
     if table.site:
         extras["crs"] = table.site.get("crs")
         extras["origin"] = table.site.get("origin")
-        extras["axes"] = "x east, y up, z south; a position is origin + (x, -z, y) in the CRS"
+        extras["axes"] = (
+            "x east, y up, z south; the root's translation holds the origin: a point the "
+            "root's transform gives as (x, y, z) is (x, -z, y) in the CRS"
+        )
     return extras
 
 

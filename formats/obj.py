@@ -44,6 +44,7 @@ from bgr.interpreter.terminals import TerminalTable
 from .gltf_materials import MaterialIndex
 from .materials import Materials, materials_of
 from .meshes import Baked, MeshPool, bake, unit_normals
+from .placement import to_site
 from .sharing import number_rows
 from .texcoords import baked_uvs
 from .text import decimal, gather, integer, left_aligned, line_starts, quantize, render, word
@@ -184,6 +185,7 @@ def write_obj(
     rows = np.lexsort((np.arange(len(table)), mats.index, label_of, lot_of))  # the file's order
     pool = MeshPool.of(table)
     baked = bake(table, rows, pool)
+    baked.vertices = to_site(baked.vertices, table.site)  # the input's frame, if any
 
     # vertices: one per distinct (object, written position) that a face uses, in file order
     used = np.zeros(len(baked.vertices), dtype=bool)

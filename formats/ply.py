@@ -18,6 +18,7 @@ from bgr.interpreter.terminals import TerminalTable
 
 from .materials import materials_of
 from .meshes import bake, srgb8, unit_normals
+from .placement import to_site
 from .sharing import number_rows
 from .text import quantize
 
@@ -50,6 +51,7 @@ def write_ply(table: TerminalTable, stream: BinaryIO, *, seed: int, attrs: dict)
     """Write the terminals as one binary PLY mesh to ``stream``."""
     table.freeze()
     baked = bake(table)
+    baked.vertices = to_site(baked.vertices, table.site)  # the input's frame, if any
     nf = np.diff(baked.fstart)
     normals = unit_normals(np.take(baked.vertices, baked.faces, axis=0))
     nq = quantize(normals)

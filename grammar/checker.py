@@ -49,6 +49,7 @@ from .registry import (
     TEX_SIZE,
     Op,
 )
+from .site import problems as site_problems
 from .textures import TextureError, load
 
 KNOWN_VERSIONS = (1,)
@@ -85,6 +86,7 @@ class Grammar:
     imports: dict[str, Grammar] = field(default_factory=dict)
     start: str | None = None
     version: int = 1
+    site: n.Site | None = None  # where its metres are on Earth (grammar/site.py)
     # the folders its imports and assets may resolve in (grammar/paths.py), set by bgr.load;
     # empty (a Grammar made by hand) leaves its assets unchecked
     roots: tuple[Path, ...] = ()
@@ -237,6 +239,13 @@ class Checker:
                     )
                 else:
                     declare("alias", item.alias, where, "import alias")
+            elif isinstance(item, n.Site):
+                if g.site is not None:
+                    self.error(item.pos, "more than one 'site' declaration")
+                else:
+                    g.site = item
+                for pos, message, hint in site_problems(item):
+                    self.error(pos, message, hint)
             elif isinstance(item, n.Start):
                 starts += 1
                 if starts > 1:

@@ -274,6 +274,10 @@ class Formatter:
             return f"terminal {', '.join(item.names)}"
         if isinstance(item, n.Start):
             return f"start {item.name}"
+        if isinstance(item, n.Site):
+            crs = "" if item.crs is None else f" {format_string(item.crs)}"
+            origin = ", ".join(format_number(v) for v in item.origin)
+            return f"site{crs} origin ({origin}) up {item.up}"
         raise TypeError(f"not a top-level item: {item!r}")
 
     def rule(self, rule: n.Rule, out: _Writer) -> None:

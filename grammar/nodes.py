@@ -307,7 +307,21 @@ class Start:
     pos: Pos = _pos()
 
 
-Item = Version | Import | Attr | Const | Func | Asset | TerminalDecl | Start | Rule
+@dataclass
+class Site:
+    """Where the grammar's metres are on Earth: its coordinates are the input's (a city that
+    ``bgr infer`` read) minus ``origin``, which is in the input's own axes, ``up`` its vertical
+    axis ("y" or "z"), ``crs`` the coordinate reference system it names (None: plain metres).
+    Writers put their output back there (docs/language.md, "Site")."""
+
+    crs: str | None
+    origin: tuple[float, float, float]
+    up: str
+    pos: Pos = _pos()
+    up_pos: Pos = _pos()
+
+
+Item = Version | Import | Attr | Const | Func | Asset | TerminalDecl | Start | Site | Rule
 
 
 @dataclass

@@ -181,6 +181,20 @@ class _TreeBuilder(Transformer):
     def start_decl(self, c):
         return n.Start(str(c[0]), pos=_span(c))
 
+    def site_decl(self, c):
+        crs, *origin, up = c
+        return n.Site(
+            None if crs is None else _unescape(crs),
+            (origin[0], origin[1], origin[2]),
+            str(up),
+            pos=_span(c),
+            up_pos=_tok_pos(up),
+        )
+
+    def coordinate(self, c):
+        value = _number(c[1])
+        return -value if c[0] == "-" else value
+
     def names(self, c):
         return list(c)
 

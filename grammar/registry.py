@@ -428,6 +428,7 @@ KEYWORDS = (
     "start",
     "asset",
     "terminal",
+    "site",
     "case",
     "else",
     "NIL",

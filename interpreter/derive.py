@@ -11,6 +11,7 @@ from pathlib import Path
 from bgr.grammar.checker import Grammar
 from bgr.grammar.errors import BgrError, Diagnostic, Warnings
 from bgr.grammar.loader import load
+from bgr.grammar.site import table_site
 
 from .batch import Job, derive_lots
 from .engine import Engine
@@ -115,7 +116,7 @@ def derive(
     for result in derive_lots(job, lots):
         shown += read.before(lots[result.index]) + result.warnings
         parts.append(result.table)
-    table = concat(parts, site=site_of(lots), grammar=str(job.grammar.path or ""))
+    table = concat(parts, site=site_of(lots, job.grammar), grammar=str(job.grammar.path or ""))
     return Result(table, seed, job.values, _once(shown + read.before(None)))
 
 
@@ -146,7 +147,7 @@ def prepare(
     attrs = _checked_attrs(attrs)
     warnings = Warnings(strict)
     lots = _lots(lot, warnings, lot_options)
-    site_of(lots)
+    site_of(lots, grammar)
     probe = Engine(grammar, seed, attrs, max_depth, max_shapes)
     values = probe.attrs  # the run's attrs
     probe.release()
@@ -202,17 +203,33 @@ def _once(items: list[Diagnostic]) -> list[Diagnostic]:
     return out
 
 
-def site_of(lots: list[Lot]) -> dict | None:
+def site_of(lots: list[Lot], grammar: Grammar | None = None) -> dict | None:
     """Where the run's local metres are on Earth (TerminalTable.site): the lots' common site
-    (read_geojson gives every lot of a file the same one), None for plain metres.  Lots placed
-    in different CRSs or about different origins cannot share one output file."""
+    (read_geojson gives every lot of a file the same one), else the grammar's ``site``
+    declaration (grammar/site.py), None for plain metres.  Lots placed in different CRSs or
+    about different origins cannot share one output file, nor lots placed on Earth and a
+    grammar that declares another place."""
     site = lots[0].site
     if any(each.site != site for each in lots):
         raise BgrError(
             "the lots are placed in different coordinate systems (their site differs); derive "
             "lots of one GeoJSON file, or lots in plain metres, together"
         )
-    return None if site is None else {"crs": site["crs"], "origin": list(site["origin"])}
+    declaration = grammar.site if grammar is not None else None
+    if declaration is None:
+        return None if site is None else {**site, "origin": list(site["origin"]), "up": "z"}
+    if site is not None:
+        raise BgrError(
+            Diagnostic(
+                str(grammar.path if grammar is not None else ""),
+                declaration.pos.line,
+                declaration.pos.column,
+                "the grammar declares a site, and the lots are placed on Earth by their own "
+                "file: only one can say where the output lies",
+                "derive the grammar on plain lots, or remove its 'site' line",
+            )
+        )
+    return table_site(declaration)
 
 
 def _shown(value: object) -> str:

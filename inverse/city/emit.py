@@ -109,8 +109,10 @@ def module(
     city: list[Placement],
     units: list[Unit],
     carried: list[tuple[Terminal, Placement]],
+    site: n.Site | None = None,
 ) -> n.Module:
-    """The whole grammar, laid out in groups with comments (see :func:`_laid_out`)."""
+    """The whole grammar, laid out in groups with comments (see :func:`_laid_out`); ``site``
+    first, where the input has one (its CRS, up axis and the offset of its coordinates)."""
     axiom = n.Rule(
         "Lot",
         [],
@@ -128,7 +130,9 @@ def module(
             ]
         ),
     )
+    placed: list[tuple[list[str], n.Item]] = [] if site is None else [([], site)]
     groups: list[list[tuple[list[str], n.Item]]] = [
+        placed,
         [([], n.Asset(t.asset, t.path)) for t in terminals + [c for c, _ in carried]],
         [
             (

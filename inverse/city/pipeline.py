@@ -20,6 +20,7 @@ from bgr.grammar import nodes as n
 from bgr.grammar.errors import BgrError
 from bgr.grammar.parser import no_gc
 from bgr.grammar.safe_text import comment_text
+from bgr.grammar.site import crs_name
 from bgr.interpreter.limits import check_memory, restart_memory
 
 from . import emit, tree
@@ -380,24 +381,38 @@ def build(
         placed.city,
         placed.units,
         [(t, p) for t, p, _, _ in placed.carried],
+        site_of(scene),
     )
     return CityGrammar(module, assets, scene, comps, placed, types)
 
 
 def _header(scene: CityScene, comps: list[Component], types: Types, placed: Placed) -> list[str]:
-    offset = ", ".join(f"{v:g}" for v in scene.offset)
-    axes = ", with (x, y, z) = (east, up, -north)" if scene.up == "z" else ""
-    crs = f" in {comment_text(scene.crs)}" if scene.crs else ""  # input text: one safe line
     lines = [
         f"# Inferred by bgr infer --kind city from {comment_text(Path(scene.source).name)}: "
         f"{len(scene.objects)} objects,",
         f"# {len(comps)} components in {len(placed.terminals)} types (level "
         f"{placed.level.index} of {len(types.levels) - 1}), {len(placed.rules)} non-terminal "
         "rules.",
-        f"# Input frame: {scene.up} up; bgr coordinates are the input's minus ({offset}){crs}"
-        f"{axes}.",
     ]
+    if site_of(scene) is not None:
+        lines.append(
+            "# The site line puts bgr derive's output back at the input's coordinates (bgr's own "
+            "are y up, local)."
+        )
+    elif scene.crs:  # a CRS pyproj does not know: said, not declared
+        lines.append(f"# The input names its CRS as {comment_text(scene.crs)}.")
     return lines
+
+
+def site_of(scene: CityScene) -> n.Site | None:
+    """The grammar's ``site`` declaration (grammar/site.py): the input's CRS (as EPSG:NNNN where
+    pyproj can name it so), its up axis and the exact offset its coordinates were re-centred
+    by; None for an input in plain local metres."""
+    crs = crs_name(scene.crs) if scene.crs else None
+    if crs is None and not np.any(scene.offset):
+        return None
+    x, y, z = (float(v) for v in scene.offset)
+    return n.Site(crs, (x, y, z), scene.up)
 
 
 @no_gc()

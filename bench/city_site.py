@@ -1,0 +1,101 @@
+"""Does an inferred city land where its input was?  (issue 29: the input's frame in the grammar)
+
+    python bench/city_site.py [FILE ...]   (default: every city of ../shared/data/cities)
+
+For each input: ``bgr infer`` (level 0), then ``bgr derive`` of the grammar to OBJ, CityJSON
+and GLB, each loaded back with no offset applied — OBJ and GLB by trimesh (the GLB through its
+node transforms, turned from glTF's y up to z up), CityJSON by its ``transform`` — and measured
+against the input with trimesh's ``closest_point`` (point to surface, both ways: the output's
+vertices and surface samples to the input, the input's to the output).  OBJ inputs are read by
+trimesh; CityJSON ones by bgr's reader (trimesh has none), put back in their own frame.
+
+Prints a Markdown table: the grammar's site line, and per output the symmetric Hausdorff
+distance (metres) and the offset between the two bounding boxes' lowest corners.
+"""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+import tempfile
+from pathlib import Path
+
+import numpy as np
+import trimesh
+
+ROOT = Path(__file__).resolve().parent.parent
+CITIES = ROOT.parent / "shared" / "data" / "cities"
+SAMPLES = 20_000
+
+
+def bgr(*args: str) -> None:
+    run = subprocess.run([sys.executable, "-m", "bgr", *args], capture_output=True, text=True)
+    if run.returncode:
+        raise SystemExit(f"bgr {' '.join(args)}: exit {run.returncode}\n{run.stderr}")
+
+
+def read_input(path: Path) -> trimesh.Trimesh:
+    if path.suffix == ".obj":
+        return trimesh.load(path, force="mesh", process=False)
+    from bgr.inverse.city.read import read_city
+
+    scene = read_city(str(path))
+    parts = [(scene.to_input(o.vertices), o.faces) for o in scene.objects]
+    return trimesh.util.concatenate([trimesh.Trimesh(v, f, process=False) for v, f in parts])
+
+
+def read_output(path: Path) -> trimesh.Trimesh:
+    if path.name.endswith(".city.json"):
+        doc = json.loads(path.read_text())
+        t = doc["transform"]
+        vertices = np.array(doc["vertices"], dtype=np.float64) * t["scale"] + t["translate"]
+        faces = []
+        for obj in doc["CityObjects"].values():
+            for geometry in obj.get("geometry", []):
+                for surface in geometry["boundaries"]:
+                    ring = surface[0]
+                    faces += [[ring[0], ring[k], ring[k + 1]] for k in range(1, len(ring) - 1)]
+        return trimesh.Trimesh(vertices, np.array(faces), process=False)
+    mesh = trimesh.load(path, force="mesh", process=False)
+    if path.suffix == ".glb":  # glTF is y up: (east, up, -north)
+        v = mesh.vertices
+        mesh = trimesh.Trimesh(np.column_stack([v[:, 0], -v[:, 2], v[:, 1]]), mesh.faces)
+    return mesh
+
+
+def one_way(to: trimesh.Trimesh, source: trimesh.Trimesh) -> float:
+    points = np.vstack([source.vertices, trimesh.sample.sample_surface(source, SAMPLES, seed=1)[0]])
+    _, distance, _ = trimesh.proximity.closest_point(to, points)
+    return float(distance.max())
+
+
+def main() -> None:
+    files = [Path(a) for a in sys.argv[1:]] or sorted(
+        p for p in CITIES.iterdir() if p.suffix in (".obj", ".json")
+    )
+    print("| input | site line | output | Hausdorff (m) | lowest corner offset (m) |")
+    print("|---|---|---|---|---|")
+    for path in files:
+        truth = read_input(path)
+        with tempfile.TemporaryDirectory() as tmp:
+            grammar = Path(tmp) / "city.bgr"
+            bgr("infer", str(path), "--no-progress", "-o", str(grammar))
+            site = next(
+                (line for line in grammar.read_text().splitlines() if line.startswith("site ")),
+                "(none)",
+            )
+            for ext in ("obj", "city.json", "glb"):
+                out = Path(tmp) / f"out.{ext}"
+                bgr("derive", str(grammar), "-o", str(out))
+                mesh = read_output(out)
+                distance = max(one_way(truth, mesh), one_way(mesh, truth))
+                offset = float(np.abs(mesh.bounds[0] - truth.bounds[0]).max())
+                print(
+                    f"| {path.name} | `{site}` | .{ext} | {distance:.4f} | {offset:.4f} |",
+                    flush=True,
+                )
+
+
+if __name__ == "__main__":
+    main()
