@@ -9,8 +9,9 @@ against the input with trimesh's ``closest_point`` (point to surface, both ways:
 vertices and surface samples to the input, the input's to the output).  OBJ inputs are read by
 trimesh; CityJSON ones by bgr's reader (trimesh has none), put back in their own frame.
 
-Prints a Markdown table: the grammar's site line, and per output the symmetric Hausdorff
-distance (metres) and the offset between the two bounding boxes' lowest corners.
+Prints two Markdown tables: the size of the grammar and of its one assets file against the
+input's; and the grammar's site line, and per output the symmetric Hausdorff distance (metres)
+and the offset between the two bounding boxes' lowest corners.
 """
 
 from __future__ import annotations
@@ -74,13 +75,18 @@ def main() -> None:
     files = [Path(a) for a in sys.argv[1:]] or sorted(
         p for p in CITIES.iterdir() if p.suffix in (".obj", ".json")
     )
-    print("| input | site line | output | Hausdorff (m) | lowest corner offset (m) |")
-    print("|---|---|---|---|---|")
+    rows, sizes = [], []
     for path in files:
         truth = read_input(path)
         with tempfile.TemporaryDirectory() as tmp:
             grammar = Path(tmp) / "city.bgr"
             bgr("infer", str(path), "--no-progress", "-o", str(grammar))
+            assets = sum(p.stat().st_size for p in (Path(tmp) / "city.assets").iterdir())
+            text = grammar.stat().st_size
+            size = path.stat().st_size
+            sizes.append(
+                f"| {path.name} | {size:,} | {text:,} | {assets:,} | {(text + assets) / size:.2f} |"
+            )
             site = next(
                 (line for line in grammar.read_text().splitlines() if line.startswith("site ")),
                 "(none)",
@@ -91,10 +97,13 @@ def main() -> None:
                 mesh = read_output(out)
                 distance = max(one_way(truth, mesh), one_way(mesh, truth))
                 offset = float(np.abs(mesh.bounds[0] - truth.bounds[0]).max())
-                print(
-                    f"| {path.name} | `{site}` | .{ext} | {distance:.4f} | {offset:.4f} |",
-                    flush=True,
-                )
+                rows.append(f"| {path.name} | `{site}` | .{ext} | {distance:.4f} | {offset:.4f} |")
+    print("| input | input bytes | grammar bytes | assets bytes | (grammar + assets) / input |")
+    print("|---|---|---|---|---|")
+    print("\n".join(sizes) + "\n")
+    print("| input | site line | output | Hausdorff (m) | lowest corner offset (m) |")
+    print("|---|---|---|---|---|")
+    print("\n".join(rows))
 
 
 if __name__ == "__main__":

@@ -12,6 +12,7 @@ import trimesh
 
 import bgr
 from bgr.cli import main
+from bgr.formats.assets_folder import MANIFEST
 from bgr.formats.meshes import bake
 from bgr.inverse.city.cuts import cut_heights, slabs
 from bgr.inverse.city.model import CityObject, CityScene
@@ -208,8 +209,9 @@ def test_infer_prints_the_grammar_and_puts_the_assets_in_the_working_folder(
     monkeypatch.chdir(work)
     assert main(["infer", str(src), "--no-progress"]) == 0
     out = capsys.readouterr().out
-    assert 'asset type1 = "city.assets/type1.glb"' in out
-    assert (work / "city.assets" / "type1.glb").is_file()
+    assert 'asset type1 = "city.assets/meshes.glb#type1"' in out
+    # every type's mesh in one file (issue 29), a node each
+    assert sorted(p.name for p in (work / "city.assets").iterdir()) == [MANIFEST, "meshes.glb"]
     (work / "city.bgr").write_text(out)
     assert main(["check", "city.bgr"]) == 0
 

@@ -161,7 +161,7 @@ def test_an_empty_folder_is_taken_and_the_grammar_names_it(tmp_path, capsys):
     (tmp_path / "meshes").mkdir()
     out = tmp_path / "city.bgr"
     assert main(infer(str(source), "-o", str(out), "--assets", str(tmp_path / "meshes"))) == 0
-    assert '"meshes/type1.glb"' in out.read_text()
+    assert '"meshes/meshes.glb#type1"' in out.read_text()
     assert (tmp_path / "meshes" / MANIFEST).is_file()
     assert sorted(p.name for p in tmp_path.iterdir()) == ["city.bgr", "city.obj", "meshes"]
 

@@ -212,9 +212,7 @@ def test_cityjson_input_keeps_its_crs(tmp_path):
         "CityObjects": {
             "b1": {
                 "type": "Building",
-                "geometry": [
-                    {"type": "Solid", "lod": "2", "boundaries": [[[r] for r in rings]]}
-                ],
+                "geometry": [{"type": "Solid", "lod": "2", "boundaries": [[[r] for r in rings]]}],
             }
         },
         "vertices": [[x * 12000, y * 9000, z * 10000] for x, y, z in corners],

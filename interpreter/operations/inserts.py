@@ -6,7 +6,7 @@ from pathlib import Path
 
 import numpy as np
 
-from bgr.grammar.errors import BgrError
+from bgr.grammar.errors import BgrError, suggest
 from bgr.grammar.paths import ALLOW_HINT, check_input, within
 from bgr.grammar.registry import PRIMITIVES
 
@@ -57,9 +57,11 @@ def _load_asset(app, step, module, asset):
     cache = app.engine.__dict__.setdefault("asset_cache", {})
     base = Path(module.path).parent if module.path not in ("<text>", "<stdin>") else Path.cwd()
     base = module.folder or base  # the real folder: a stdlib module's path is only its name
-    path = (base / asset.path).resolve()
-    if path in cache:
-        return cache[path]
+    file_name, mesh_name = split_fragment(base, asset.path)
+    path = (base / file_name).resolve()
+    key = (path, mesh_name)
+    if key in cache:
+        return cache[key]
     if module.roots and not within(path, module.roots):
         raise runtime_error(
             module,
@@ -81,8 +83,11 @@ def _load_asset(app, step, module, asset):
         raise runtime_error(
             module, asset.pos, f"asset file '{asset.path}' not found", f"looked for {path}"
         )
-    textured = _textured(app, module, asset, path)
-    if textured is not None:
+    textured = None if mesh_name is not None else _textured(app, module, asset, path)
+    if mesh_name is not None:
+        uv = image = None
+        verts, faces = _named_mesh(app, module, asset, path, mesh_name)
+    elif textured is not None:
         verts, faces, uv, image = textured
     else:
         uv = image = None
@@ -101,8 +106,54 @@ def _load_asset(app, step, module, asset):
     extent = hi - lo
     unit = (verts - lo) / np.where(extent > 0, extent, 1.0)
     mesh_id = app.engine.table.library.add(UnitMesh(asset.name, unit, faces, uv, image))
-    cache[path] = (mesh_id, tuple(extent.tolist()), tuple(lo.tolist()))
-    return cache[path]
+    cache[key] = (mesh_id, tuple(extent.tolist()), tuple(lo.tolist()))
+    return cache[key]
+
+
+def split_fragment(base: Path, path: str) -> tuple[str, str | None]:
+    """``("meshes.glb", "type1")`` for ``meshes.glb#type1``: a glTF file and the mesh it holds
+    under that node name (``bgr infer --kind city`` writes one file of every type's mesh); the
+    path itself, and None, when it names a file as it is or holds no ``#``."""
+    head, mark, name = path.rpartition("#")
+    if not mark or not name or not head.lower().endswith((".glb", ".gltf")):
+        return path, None
+    try:
+        if (base / path).is_file():  # a file whose name holds a '#'
+            return path, None
+    except (OSError, ValueError):
+        pass
+    return head, name
+
+
+def _named_mesh(app, module, asset, path: Path, name: str) -> tuple[np.ndarray, np.ndarray]:
+    """The triangles of node ``name`` of a glTF file (its transform applied), the file read
+    once per derivation however many of its meshes the grammar inserts."""
+    files = app.engine.__dict__.setdefault("asset_files", {})
+    if path not in files:
+        try:
+            import trimesh
+
+            scene = trimesh.load(path, force="scene", process=False)
+            nodes = {}
+            for node in scene.graph.nodes_geometry:
+                matrix, geometry = scene.graph[node]
+                mesh = scene.geometry[geometry]
+                verts = np.asarray(mesh.vertices, dtype=float) @ matrix[:3, :3].T + matrix[:3, 3]
+                nodes[str(node)] = (verts, np.asarray(mesh.faces))
+        except Exception as e:  # any reader failure is the file's fault, not ours
+            raise runtime_error(
+                module, asset.pos, f"cannot read asset '{asset.path}': {e}"
+            ) from None
+        files[path] = nodes
+    nodes = files[path]
+    if name not in nodes:
+        raise runtime_error(
+            module,
+            asset.pos,
+            f"asset '{asset.path}': {path.name} has no mesh named '{name}'",
+            suggest(name, nodes) or f"it holds {len(nodes)} meshes",
+        )
+    return nodes[name]
 
 
 TEXTURED_ASSETS = (".obj", ".glb", ".gltf")

@@ -10,7 +10,7 @@ from bgr.grammar.errors import BgrError, terminal_text
 from bgr.grammar.safe_text import comment_text, unwritable
 
 from .components import FEATURES
-from .pipeline import Options, infer_city, level_stats, to_text, write
+from .pipeline import MESHES, Options, infer_city, level_stats, to_text, write
 
 USAGE = 2
 
@@ -87,8 +87,9 @@ def run(args) -> int:
     print(
         f"{terminal_text(args.input, keep='')}: {len(grammar.scene.objects)} objects, "
         f"{len(grammar.comps)} components, {len(placed.terminals)} types at level "
-        f"{placed.level.index}, {len(placed.rules)} rules{wrote} and {len(grammar.assets)} meshes "
-        f"in {terminal_text(str(assets_dir), keep='')}",
+        f"{placed.level.index}, {len(placed.rules)} rules{wrote} and "
+        f"{len(placed.terminals) + len(placed.carried)} meshes in "
+        f"{terminal_text(str(assets_dir / MESHES), keep='')}",
         file=sys.stderr,
     )
     if args.stats:

@@ -29,6 +29,7 @@ from .components import Component
 from .model import CityScene
 from .types import Level, Types, cluster, level_for
 
+MESHES = "meshes.glb"  # the one file of the assets folder: every type's mesh, a node each
 READ_COST = 10  # memory per byte of a text city file (OBJ, CityJSON) read, at least (20 measured)
 
 
@@ -133,7 +134,7 @@ def place(
             emit.Terminal(
                 name_of[t],
                 f"type{i + 1}",
-                f"{options.assets}/type{i + 1}.glb",
+                f"{options.assets}/{MESHES}#type{i + 1}",
                 _colour(rep),
                 f"component type {i + 1}: {_count(int(count[t]), 'instance')}, "
                 f"{span} m (width x height x depth)",
@@ -213,7 +214,7 @@ def place(
         term = emit.Terminal(
             f"Object{len(carried) + 1}",
             f"object{len(carried) + 1}",
-            f"{options.assets}/object{len(carried) + 1}.glb",
+            f"{options.assets}/{MESHES}#object{len(carried) + 1}",
             _colour_of(obj.colors),
             f"carried through as it is: {comment_text(obj.kind, 60)} {comment_text(obj.name)} "
             f"({len(obj.faces)} triangles)",
@@ -312,10 +313,21 @@ def _colour_of(colors: np.ndarray | None) -> str | None:
     return f"#{int(r):02x}{int(g):02x}{int(b):02x}"
 
 
-def glb_bytes(vertices: np.ndarray, faces: np.ndarray) -> bytes:
-    """A mesh as GLB bytes (trimesh's exporter), vertices as given."""
+def _mesh(vertices: np.ndarray, faces: np.ndarray) -> trimesh.Trimesh:
+    """A type's mesh with its equal vertices shared (equal to 1e-8 m: trimesh's merge)."""
     mesh = trimesh.Trimesh(np.asarray(vertices, dtype=np.float64), np.asarray(faces), process=False)
-    out = mesh.export(file_type="glb")
+    mesh.merge_vertices()
+    return mesh
+
+
+def _exported(scene: trimesh.Scene) -> bytes:
+    """Every type's mesh in one GLB (trimesh's exporter), a node per mesh named as the grammar's
+    asset is (``meshes.glb#type1``), without normals: bgr derives flat-shaded faces from the
+    triangles (with the merged vertices of :func:`_mesh`, 0.78 times the file trimesh writes
+    by default on Zurich's LoD2 tile: 364,904 bytes against 467,744)."""
+    from trimesh.exchange.gltf import export_glb
+
+    out = export_glb(scene, include_normals=False)
     return bytes(out) if not isinstance(out, bytes) else out
 
 
@@ -365,14 +377,15 @@ def infer_city(
 def build(
     scene: CityScene, comps: list[Component], types: Types, placed: Placed, options: Options
 ) -> CityGrammar:
-    assets = {}
+    container = trimesh.Scene()
     with _bar(options, len(placed.terminals) + len(placed.carried), "writing meshes") as bar:
         for t, rep in zip(placed.terminals, placed.term_mesh, strict=True):
-            assets[Path(t.path).name] = glb_bytes(rep.vertices, rep.faces)
+            container.add_geometry(_mesh(rep.vertices, rep.faces), t.asset, t.asset)
             bar.update()
         for t, _, vertices, faces in placed.carried:
-            assets[Path(t.path).name] = glb_bytes(vertices, faces)
+            container.add_geometry(_mesh(vertices, faces), t.asset, t.asset)
             bar.update()
+    assets = {MESHES: _exported(container)} if container.geometry else {}
     header = _header(scene, comps, types, placed)
     module = emit.module(
         header,
