@@ -81,7 +81,9 @@ def test_obj_without_objects_has_its_groups_as_objects(tmp_path):
     text = "g roof\n" + box_obj(0, 0, 0, 1, 1, 1, 0) + "g wall\n" + box_obj(3, 0, 0, 4, 1, 1, 8)
     text += "g roof\nv 0 0 5\nv 1 0 5\nv 1 1 5\nf 17 18 19\n"
     scene = read_city(write_text(tmp_path / "groups.obj", text))
-    assert [(o.name, len(o.faces)) for o in scene.objects] == [("roof", 13), ("wall", 12)]
+    # the group's triangle lies apart from its box on the ground (y is up): a building of its own
+    groups = [(o.name, len(o.faces)) for o in scene.objects]
+    assert groups == [("roof/1", 12), ("roof/2", 1), ("wall", 12)]
 
 
 def test_obj_without_names_is_cut_into_connected_components(tmp_path):
@@ -91,6 +93,42 @@ def test_obj_without_names_is_cut_into_connected_components(tmp_path):
     assert [len(o.faces) for o in scene.objects] == [12, 12]
     heights = [o.vertices[:, 1].max() for o in scene.objects]
     assert heights == [8.0, 12.0]  # numbered by their first face: the file's order
+
+
+def test_an_object_of_several_buildings_is_split_into_them(tmp_path):
+    """Issue 29: a file that puts two buildings apart on the ground into one object gives two
+    objects, NAME/1 and NAME/2, in the order of their first faces; others keep their place."""
+    text = "o pair\n" + box_obj(0, 0, 0, 10, 10, 8, 0) + box_obj(30, 0, 0, 40, 10, 12, 8)
+    text += "o single\n" + box_obj(60, 0, 0, 70, 10, 8, 16)
+    text += "o terrace\n" + box_obj(80, 0, 0, 90, 10, 8, 24) + box_obj(90, 0, 0, 95, 10, 4, 32)
+    scene = read_city(write_text(tmp_path / "pair.obj", text), up="z")
+    names = [(o.name, len(o.faces), o.vertices[:, 1].max()) for o in scene.objects]
+    assert names == [
+        ("pair/1", 12, 8.0),
+        ("pair/2", 12, 12.0),
+        ("single", 12, 8.0),
+        ("terrace", 24, 8.0),  # two boxes that touch: one building
+    ]
+
+
+def test_carried_objects_are_not_split(tmp_path):
+    """A CityJSON Road in two pieces stays one object (carried through as it is)."""
+    road = [[[0, 1, 2, 3]], [[4, 5, 6, 7]]]
+    doc = {
+        "type": "CityJSON",
+        "version": "2.0",
+        "transform": {"scale": [1, 1, 1], "translate": [0, 0, 0]},
+        "CityObjects": {
+            "r": {
+                "type": "Road",
+                "geometry": [{"type": "MultiSurface", "lod": "1", "boundaries": road}],
+            },
+        },
+        "vertices": [[0, 0, 0], [5, 0, 0], [5, 5, 0], [0, 5, 0]]
+        + [[50, 0, 0], [55, 0, 0], [55, 5, 0], [50, 5, 0]],
+    }
+    scene = read_city(write_text(tmp_path / "road.city.json", json.dumps(doc)))
+    assert [(o.name, o.proceduralize, len(o.faces)) for o in scene.objects] == [("r", False, 4)]
 
 
 def test_a_window_floating_in_front_of_a_facade_joins_its_building(tmp_path):

@@ -33,6 +33,7 @@ from bgr.grammar.paths import read_input
 
 from .coordinates import Locate, check_coordinates
 from .model import CityObject, CityScene
+from .objects import components, separate
 
 if TYPE_CHECKING:
     import trimesh
@@ -56,8 +57,6 @@ PROCEDURAL_TYPES = ("Building", "BuildingPart")  # CityJSON types that are proce
 
 RECENTRE_FROM = 1000.0  # metres: a horizontal centre farther than this from 0 is re-centred
 LIFT_FROM = 100.0  # metres: a lowest point farther than this from 0 is brought to about 0
-WELD = 1e-6  # of the scene's size: positions this close are one vertex (connected components)
-PLAN_GAP = 0.2  # metres: components whose ground-plane boxes come this close are one object
 
 
 # --------------------------------------------------------------------------------------------
@@ -196,6 +195,8 @@ def _scene(shown: str, found: Found, up: str) -> CityScene:
     if owner is None:
         owner, count = components(local, faces)
         objects = [_template(f"object-{k}") for k in range(1, count + 1)]
+    else:
+        owner, objects = separate(local, faces, owner, objects)
     scene.objects = _split(local, faces, colors, owner, objects)
     return scene
 
@@ -268,71 +269,6 @@ def _split(
         obj.colors = None if colors is None else colors[order[lo:hi]]
         out.append(obj)
     return out
-
-
-# --------------------------------------------------------------------------------------------
-# objects of a mesh without any: connected components
-
-
-def components(vertices: np.ndarray, faces: np.ndarray) -> tuple[np.ndarray, int]:
-    """(object of each face, number of objects) for a mesh that names none.
-
-    Faces sharing a vertex (positions equal to WELD of the scene's size) are one component;
-    components whose boxes in the ground plane (bgr's x and z) come within PLAN_GAP are then
-    one object, until no two do (a window modelled as a loose quad in front of its façade joins
-    its building; a building in a courtyard its block).  Objects are numbered by their first
-    face."""
-    from scipy.sparse import coo_matrix
-    from scipy.sparse.csgraph import connected_components
-
-    used, local = np.unique(faces, return_inverse=True)  # unused vertices may be anything
-    weld = _weld(vertices[used])[local.reshape(-1, 3)]  # (F, 3) welded vertex ids
-    n = int(weld.max()) + 1
-    edges = np.concatenate([weld[:, [0, 1]], weld[:, [1, 2]]])
-    graph = coo_matrix((np.ones(len(edges), dtype=np.int32), (edges[:, 0], edges[:, 1])), (n, n))
-    _, of_vertex = connected_components(graph, directed=False)
-    label = of_vertex[weld[:, 0]].astype(np.int64)
-    label = _merge_plan_overlaps(vertices, faces, label)
-    _, first = np.unique(label, return_index=True)
-    rank = np.empty(len(first), dtype=np.int64)
-    rank[np.argsort(first, kind="stable")] = np.arange(len(first))
-    return rank[np.searchsorted(np.unique(label), label)], len(first)
-
-
-def _weld(vertices: np.ndarray) -> np.ndarray:
-    """Each vertex's id, equal for positions that round to the same point of a grid of WELD
-    times the scene's size (the ids of one 64-bit key per point: sorting rows is slower)."""
-    lo = vertices.min(axis=0)
-    size = float((vertices.max(axis=0) - lo).max()) or 1.0
-    q = np.rint((vertices - lo) / (size * WELD)).astype(np.int64)  # 0 .. 1e6 < 2**20 per axis
-    key = (q[:, 0] << 42) | (q[:, 1] << 21) | q[:, 2]
-    return np.unique(key, return_inverse=True)[1].reshape(-1)
-
-
-def _merge_plan_overlaps(vertices: np.ndarray, faces: np.ndarray, label: np.ndarray) -> np.ndarray:
-    """Labels of components merged while their ground-plane boxes overlap (within PLAN_GAP):
-    merging makes boxes larger, so it repeats until the number of objects stays the same."""
-    import shapely
-    from scipy.sparse import coo_matrix
-    from scipy.sparse.csgraph import connected_components
-
-    corners = vertices[faces][:, :, [0, 2]]  # (F, 3, 2): bgr's ground plane
-    face_lo, face_hi = corners.min(axis=1), corners.max(axis=1)
-    _, label = np.unique(label, return_inverse=True)
-    while True:
-        n = int(label.max()) + 1
-        lo = np.full((n, 2), np.inf)
-        hi = np.full((n, 2), -np.inf)
-        np.minimum.at(lo, label, face_lo)
-        np.maximum.at(hi, label, face_hi)
-        half = PLAN_GAP / 2
-        boxes = shapely.box(lo[:, 0] - half, lo[:, 1] - half, hi[:, 0] + half, hi[:, 1] + half)
-        a, b = shapely.STRtree(boxes).query(boxes, predicate="intersects")
-        graph = coo_matrix((np.ones(len(a), dtype=np.int32), (a, b)), (n, n))
-        count, merged = connected_components(graph, directed=False)
-        label = merged[label].astype(np.int64)
-        if count == n:
-            return label
 
 
 # --------------------------------------------------------------------------------------------
