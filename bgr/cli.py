@@ -343,6 +343,14 @@ def build_parser() -> argparse.ArgumentParser:
         "distance to the nearest building)",
     )
     city.add_argument(
+        "--tolerance",
+        type=float,
+        default=0.01,
+        metavar="METRES",
+        help="level 0's bound: components whose meshes agree within it are one type "
+        "(default 0.01: 1 cm)",
+    )
+    city.add_argument(
         "--representative",
         choices=["mean", "fewest"],
         default="mean",

@@ -167,19 +167,21 @@ def test_editing_one_type_changes_every_instance_of_it_and_nothing_else(tmp_path
 
 # delft.obj (2,000+ buildings) is the long one: `pytest -m slow`
 @pytest.mark.parametrize(
-    "name",
+    "name, tolerance",
     [
-        pytest.param("delft.obj", marks=pytest.mark.slow),
-        "zurich_lod2.obj",
-        "zurich_lod2.city.json",
+        pytest.param("delft.obj", 0.01, marks=pytest.mark.slow),
+        ("zurich_lod2.obj", 0.01),  # the default
+        ("zurich_lod2.obj", 0.001),
+        ("zurich_lod2.city.json", 0.0001),
     ],
 )
-def test_level_0_of_a_real_city_derives_back_within_a_millimetre(tmp_path, name):
+def test_level_0_of_a_real_city_derives_back_within_its_tolerance(tmp_path, name, tolerance):
     source = CITIES / name
     if not source.is_file():
         pytest.skip("../shared/data is not here")
     out = tmp_path / "city.bgr"
-    assert main(["infer", str(source), "-o", str(out), "--no-progress"]) == 0
+    args = ["infer", str(source), "-o", str(out), "--no-progress"]
+    assert main([*args, "--tolerance", str(tolerance)]) == 0
     result = bgr.derive(bgr.load(out.read_text(), path=str(out)))
     baked = bake(result.terminals)
     from bgr.inverse.city.distance import surface_distances
@@ -190,7 +192,36 @@ def test_level_0_of_a_real_city_derives_back_within_a_millimetre(tmp_path, name)
     starts = np.cumsum([0] + [len(o.vertices) for o in scene.objects])
     faces = np.concatenate([o.faces + s for o, s in zip(scene.objects, starts, strict=False)])
     d = surface_distances(verts, faces, baked.vertices, baked.faces)
-    assert d.hausdorff < 1e-3
+    assert d.hausdorff < tolerance
+
+
+def test_components_within_the_tolerance_are_one_type(tmp_path):
+    """Two boxes 1 mm apart in width: one type at the default 1 cm, two at 0.5 mm.  (Meshes
+    are compared on a grid of tolerance / sqrt(3): equal there, they agree within the
+    tolerance; nearer than that, they may still straddle a cell's edge.)"""
+    first, second = box(0, 0, 0, 10, 6, 8), box(20, 0, 0, 30.001, 6, 8)
+    lines, base = [], 1
+    for k, m in enumerate((first, second)):
+        lines.append(f"o b{k}")
+        lines += [f"v {x:.4f} {y:.4f} {z:.4f}" for x, y, z in m.vertices]
+        lines += [f"f {a + base} {b + base} {c + base}" for a, b, c in m.faces]
+        base += len(m.vertices)
+    source = tmp_path / "two.obj"
+    source.write_text("\n".join(lines) + "\n")
+    for tolerance, types in (("0.01", 1), ("0.0005", 2)):
+        out = tmp_path / f"t{types}.bgr"
+        assert (
+            main(["infer", str(source), "--up", "y", "--tolerance", tolerance, "-o", str(out)]) == 0
+        )
+        assert bgr.load(out).assets.keys() == {f"type{k + 1}" for k in range(types)}
+
+
+def test_a_tolerance_out_of_range_is_refused(tmp_path, capsys):
+    source = tmp_path / "one.obj"
+    source.write_text("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n")
+    for bad in ("0", "-1", "nan", "2"):
+        assert main(["infer", str(source), "--tolerance", bad, "-o", str(tmp_path / "x.bgr")]) == 2
+        assert "--tolerance must be a distance over 0" in capsys.readouterr().err
 
 
 # ---- the command line -------------------------------------------------------------------------

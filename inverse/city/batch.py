@@ -30,7 +30,9 @@ from .model import CityObject
 
 
 def decompose_all(
-    objects: list[CityObject], progress: Callable[[int], object] | None = None
+    objects: list[CityObject],
+    progress: Callable[[int], object] | None = None,
+    grid: float = KEY_GRID,
 ) -> list[Component]:
     """The components of every object to proceduralize, in the order that cutting and fitting
     one object after another gives (:func:`.pipeline.decompose`); ``progress(n)`` is told of
@@ -50,7 +52,7 @@ def decompose_all(
             cuts = cut_heights(obj.vertices, obj.faces)
             found += [(i, s) for s in slabs(obj.vertices, obj.faces, cuts)]
             tell(1)
-    return fit_all(found, objects)
+    return fit_all(found, objects, grid)
 
 
 def _uncut(objects: list[CityObject]) -> np.ndarray:
@@ -117,7 +119,9 @@ class _Stack:
         return np.diff(self.v_start)
 
 
-def fit_all(found: list[tuple[int, Slab]], objects: list[CityObject]) -> list[Component]:
+def fit_all(
+    found: list[tuple[int, Slab]], objects: list[CityObject], grid: float = KEY_GRID
+) -> list[Component]:
     """:func:`.components.fit` of every slab (with the object it came from): the minimum
     rectangle's angle, the four quarter turns' mesh keys, the frame with the least key."""
     if not found:
@@ -134,7 +138,7 @@ def fit_all(found: list[tuple[int, Slab]], objects: list[CityObject]) -> list[Co
         local = local - np.repeat(low, stack.v_count, axis=0)
         locals_.append(local)
         lows.append(low)
-        keys.append(_mesh_keys(stack, local))
+        keys.append(_mesh_keys(stack, local, grid))
     best = np.array(keys).argmin(axis=0)  # the first quarter of the least key
     chosen = np.repeat(best, stack.v_count)
     vertices = locals_[0]
@@ -221,9 +225,9 @@ def _times(stack: _Stack, axes: np.ndarray) -> np.ndarray:
     return out
 
 
-def _mesh_keys(stack: _Stack, local: np.ndarray) -> list[str]:
+def _mesh_keys(stack: _Stack, local: np.ndarray, key_grid: float) -> list[str]:
     """:func:`.components.mesh_key` of every slab's mesh, its vertices ``local``."""
-    grid = np.rint(local / KEY_GRID).astype(np.int64)
+    grid = np.rint(local / key_grid).astype(np.int64)
     n = len(stack.f_start) - 1
     f_count = np.diff(stack.f_start)
     tri_slab = np.repeat(np.arange(n), f_count)

@@ -44,6 +44,8 @@ def run(args) -> int:
                 raise ValueError(f"{option} must be a number, 0 or more")
         if args.tau is not None and not 0 < args.tau < float("inf"):
             raise ValueError("--tau must be a distance over 0 metres")
+        if not 0 < args.tolerance <= 1:
+            raise ValueError("--tolerance must be a distance over 0 and at most 1 metre")
         if args.threshold is not None and not 0 <= args.threshold < float("inf"):
             raise ValueError("--threshold must be a number, 0 or more")
     except ValueError as e:
@@ -76,6 +78,7 @@ def run(args) -> int:
         w_sigma=args.w_sigma,
         tau=args.tau,
         representative=args.representative,
+        tolerance=args.tolerance,
         assets=named,
         progress=not args.no_progress and sys.stderr.isatty(),
     )

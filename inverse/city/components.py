@@ -19,7 +19,16 @@ from trimesh.bounds import oriented_bounds_2D
 
 from .cuts import Slab
 
-KEY_GRID = 1e-4  # metres: meshes equal on this grid share a key (level 0 is exact within 1 mm)
+TOLERANCE = 0.01  # metres: level 0's default bound (bgr infer --tolerance)
+
+
+def key_grid(tolerance: float) -> float:
+    """The grid meshes are compared on: two meshes equal on it differ by at most ``tolerance``
+    at any corner (a corner moves at most one cell along each axis: sqrt(3) cells in all)."""
+    return tolerance / np.sqrt(3.0)
+
+
+KEY_GRID = key_grid(TOLERANCE)
 
 # the feature vector (paper, section IV.C), in units where 1 is a noticeable difference
 FEATURES = (
@@ -44,7 +53,7 @@ class Component:
     vertices: np.ndarray  # (V, 3) in the box frame: within [0, size]
     faces: np.ndarray  # (F, 3)
     colors: np.ndarray | None  # (F, 4) uint8 or None
-    key: str  # equal for meshes equal on KEY_GRID (in their chosen frame)
+    key: str  # equal for meshes equal on the key grid (in their chosen frame)
     angle: float  # degrees, the rectangle's rotation about the vertical, in [0, 90)
 
 
@@ -56,10 +65,10 @@ def _turn(angle_deg: float) -> np.ndarray:
     return np.column_stack([x, y, np.cross(x, y)])
 
 
-def mesh_key(vertices: np.ndarray, faces: np.ndarray) -> str:
+def mesh_key(vertices: np.ndarray, faces: np.ndarray, grid: float = KEY_GRID) -> str:
     """A digest of a mesh that does not depend on vertex or triangle order (nor on where each
     triangle's corner list starts), only on the triangles' corners on the KEY_GRID."""
-    grid = np.rint(vertices / KEY_GRID).astype(np.int64)
+    grid = np.rint(vertices / grid).astype(np.int64)
     tri = grid[faces]  # (F, 3, 3)
     # start each triangle at its smallest corner, keeping the winding
     order = np.argmin(_corner_rank(tri), axis=1)
@@ -78,7 +87,7 @@ def _corner_rank(tri: np.ndarray) -> np.ndarray:
     return rank.reshape(-1, 3)
 
 
-def fit(slab: Slab, building: int, colors: np.ndarray | None) -> Component:
+def fit(slab: Slab, building: int, colors: np.ndarray | None, grid: float = KEY_GRID) -> Component:
     """The component of a slab: its box, its mesh in the box's frame, its key."""
     ground = slab.vertices[:, [0, 2]]
     angle = 0.0
@@ -97,7 +106,7 @@ def fit(slab: Slab, building: int, colors: np.ndarray | None) -> Component:
         low = local.min(axis=0)
         low[1] = bottom
         local = local - low
-        key = mesh_key(local, slab.faces)
+        key = mesh_key(local, slab.faces, grid)
         if best is None or key < best[0]:
             origin = axes @ low
             frame = np.eye(4)

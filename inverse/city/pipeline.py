@@ -25,7 +25,7 @@ from bgr.interpreter.limits import check_memory, restart_memory
 
 from . import emit, tree
 from .batch import building_stacks, decompose_all
-from .components import Component
+from .components import TOLERANCE, Component, key_grid
 from .model import CityScene
 from .types import Level, Types, cluster, level_for
 
@@ -45,6 +45,7 @@ class Options:
     w_sigma: float = 1.0
     tau: float | None = None  # neighbour distance (equation 3); default from the data
     representative: str = "mean"  # or "fewest" (triangles)
+    tolerance: float = TOLERANCE  # metres: level 0's bound (components.key_grid)
     assets: str = "city.assets"  # the assets folder as the grammar names it
     progress: bool = True
     seed: int = 0
@@ -110,7 +111,7 @@ def decompose(scene: CityScene, options: Options) -> list[Component]:
     """Every building object cut into components (cut planes, slabs, boxes): all objects at
     once (:mod:`.batch`), as cutting and fitting each in turn would."""
     with _bar(options, len(scene.objects), "cutting buildings") as bar:
-        return decompose_all(scene.objects, bar.update)
+        return decompose_all(scene.objects, bar.update, key_grid(options.tolerance))
 
 
 def place(

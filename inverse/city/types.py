@@ -1,7 +1,8 @@
 """Component types: dissimilarity clustering of components (paper, section IV.D).
 
-Level 0 is exact: components whose meshes are equal (same key, see :mod:`.components`) are one
-type, so deriving the grammar gives every input triangle back.  Above it, the paper's k-means
+Level 0 is lossless within the tolerance: components whose meshes are equal on the key grid
+(same key, see :mod:`.components`) are one type, so deriving the grammar gives every input
+triangle back within it.  Above it, the paper's k-means
 hierarchy: k-means on the level-0 types' feature vectors with k = n/2, then on the cluster
 centres with k halved again, until k = 1; level l is the l-th cut through that tree.  The
 dissimilarity is d_ij = ||W (F_i - F_j)|| (equation 1), W a unit-length weight vector.  The
