@@ -681,6 +681,11 @@ class _Gen:
         items = []
         if self.chance(0.5):
             items.append(["version", "1"])
+        if self.chance(0.2):  # where the output lands: every output writer must still work
+            crs = ['"EPSG:2056"'] if self.chance(0.5) else []
+            origin = [self.d(st.sampled_from(["0", "2682812.5", "-1247000", "1e7"])) for _ in "xyz"]
+            up = self.d(st.sampled_from(["y", "z"]))
+            items.append(["site", *crs, "origin", "(", *_commas(origin), ")", "up", up])
         if palette:
             items.append(["import", "stdlib.palette", "as", "pal"])
         values = attrs + consts
