@@ -70,6 +70,28 @@ def test_slabs_cover_the_building_exactly_when_walls_cross_a_cut():
     assert area == pytest.approx(m.area)
     assert parts[0].vertices[:, 1].max() == pytest.approx(6.0)
     assert parts[1].vertices[:, 1].min() == pytest.approx(6.0)
+    # each tall wall's two strips are two triangles each, not the six pieces clipping leaves
+    # (issue 29): below, the tall box's bottom and lower strips and the whole low box; above,
+    # the upper strips and the top
+    assert [len(p.faces) for p in parts] == [22, 10]
+
+
+def test_clipped_pieces_of_two_colours_are_not_merged():
+    """A wall rectangle crossing a cut: its strips are merged into two triangles each when
+    both halves have one colour, and left as clipped (three pieces a half) when they differ."""
+    v = np.array([[0, 0, 0], [4, 0, 0], [4, 10, 0], [0, 10, 0]], float)
+    f = np.array([[0, 1, 2], [0, 2, 3]])
+    one = np.array([[200, 0, 0, 255], [200, 0, 0, 255]], np.uint8)
+    two = np.array([[200, 0, 0, 255], [0, 0, 200, 255]], np.uint8)
+    merged = slabs(v, f, [6.0], one)
+    assert [len(p.faces) for p in merged] == [2, 2]
+    for p in merged:  # facing as the wall did (+z)
+        assert np.allclose(trimesh.Trimesh(p.vertices, p.faces).face_normals, [0, 0, 1])
+    kept = slabs(v, f, [6.0], two)
+    assert sum(len(p.faces) for p in kept) == 6
+    for parts in (merged, kept):
+        area = sum(trimesh.Trimesh(p.vertices, p.faces).area for p in parts)
+        assert area == pytest.approx(40.0)
 
 
 # ---- the street of repeated patterns ----------------------------------------------------------

@@ -50,7 +50,7 @@ def decompose_all(
             found += [(i, slab)] if slab is not None else []
         else:
             cuts = cut_heights(obj.vertices, obj.faces)
-            found += [(i, s) for s in slabs(obj.vertices, obj.faces, cuts)]
+            found += [(i, s) for s in slabs(obj.vertices, obj.faces, cuts, obj.colors)]
             tell(1)
     return fit_all(found, objects, grid)
 

@@ -20,7 +20,8 @@ to the last cut, the bottom or the top is passed over), where the rendered conto
 would not show a difference either.
 
 Each slab between consecutive cuts is a component: the triangles inside it, with those that cross
-a cut clipped at the plane (trimesh's ``slice_faces_plane``), so the components together cover
+a cut clipped at the plane (trimesh's ``slice_faces_plane``; the pieces of one plane then merged
+back into fewer triangles, :mod:`.remesh`), so the components together cover
 exactly the building's surface.  A horizontal face lying on a cut goes to the slab it closes: an
 upward-facing terrace to the slab below, a downward-facing overhang to the slab above.
 """
@@ -31,6 +32,8 @@ from dataclasses import dataclass
 
 import numpy as np
 from trimesh.intersections import slice_faces_plane
+
+from .remesh import merge_pieces, plane_keys
 
 HEIGHT_TOL = 1e-4  # metres: vertex heights closer than this are one height
 HORIZONTAL = 0.995  # |n_up| above this (under 5.7 degrees): a flat face (a step, not a slope)
@@ -131,9 +134,16 @@ def cut_heights(vertices: np.ndarray, faces: np.ndarray) -> list[float]:
     return cuts
 
 
-def slabs(vertices: np.ndarray, faces: np.ndarray, cuts: list[float]) -> list[Slab]:
+def slabs(
+    vertices: np.ndarray,
+    faces: np.ndarray,
+    cuts: list[float],
+    colors: np.ndarray | None = None,
+) -> list[Slab]:
     """The building's triangles cut into one slab per interval between its cuts (see the module
-    docstring); slabs that get no triangles are left out."""
+    docstring); slabs that get no triangles are left out.  The clipped pieces of each slab are
+    merged back plane by plane (:mod:`.remesh`; ``colors``, one per face: pieces of different
+    colours are not merged)."""
     if len(faces) == 0:
         return []
     bottom, top = float(vertices[:, 1].min()), float(vertices[:, 1].max())
@@ -141,6 +151,7 @@ def slabs(vertices: np.ndarray, faces: np.ndarray, cuts: list[float]) -> list[Sl
     heights = vertices[faces][:, :, 1]
     lo, hi = heights.min(axis=1), heights.max(axis=1)
     normals, _ = _face_geometry(vertices, faces)
+    keys = None  # each face's plane (and colour), the first time a face is clipped
     out = []
     for i in range(len(levels) - 1):
         z0, z1 = levels[i], levels[i + 1]
@@ -156,6 +167,9 @@ def slabs(vertices: np.ndarray, faces: np.ndarray, cuts: list[float]) -> list[Sl
         parts_v, parts_f, parts_s = [vertices], [faces[whole]], [whole]
         if len(crossing):
             v, f, tag = _clip(vertices, faces, crossing, z0, z1)
+            if keys is None:
+                keys = plane_keys(vertices, faces, colors)
+            v, f, tag = merge_pieces(v, f, tag, keys[tag])
             parts_v.append(v)
             parts_f.append(f + len(vertices))
             parts_s.append(tag)
