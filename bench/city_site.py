@@ -1,6 +1,6 @@
 """Does an inferred city land where its input was?  (issue 29: the input's frame in the grammar)
 
-    python bench/city_site.py [FILE ...]   (default: every city of ../shared/data/cities)
+    python bench/city_site.py [--levels] [FILE ...]   (default: every city of ../shared/data/cities)
 
 For each input: ``bgr infer`` (level 0), then ``bgr derive`` of the grammar to OBJ, CityJSON
 and GLB, each loaded back with no offset applied — OBJ and GLB by trimesh (the GLB through its
@@ -10,8 +10,11 @@ vertices and surface samples to the input, the input's to the output).  OBJ inpu
 trimesh; CityJSON ones by bgr's reader (trimesh has none), put back in their own frame.
 
 Prints two Markdown tables: the size of the grammar and of its one assets file against the
-input's; and the grammar's site line, and per output the symmetric Hausdorff distance (metres)
-and the offset between the two bounding boxes' lowest corners.
+city's OBJ (its own OBJ file where one is shipped, else its triangles written as OBJ to the
+millimetre); and the grammar's site line, and per output the symmetric Hausdorff distance
+(metres) and the offset between the two bounding boxes' lowest corners.  ``--levels`` adds a
+third: every level above 0, its size against the OBJ and its Chamfer distance to the input
+(the mean of the two one-way mean distances, trimesh's ``closest_point``).
 """
 
 from __future__ import annotations
@@ -65,27 +68,71 @@ def read_output(path: Path) -> trimesh.Trimesh:
     return mesh
 
 
-def one_way(to: trimesh.Trimesh, source: trimesh.Trimesh) -> float:
+def distances(to: trimesh.Trimesh, source: trimesh.Trimesh) -> np.ndarray:
     points = np.vstack([source.vertices, trimesh.sample.sample_surface(source, SAMPLES, seed=1)[0]])
     _, distance, _ = trimesh.proximity.closest_point(to, points)
-    return float(distance.max())
+    return distance
+
+
+def one_way(to: trimesh.Trimesh, source: trimesh.Trimesh) -> float:
+    return float(distances(to, source).max())
+
+
+def obj_bytes(path: Path, truth: trimesh.Trimesh) -> int:
+    """The size of the city as OBJ: its own OBJ file where ../shared/data has one, else its
+    triangles written as OBJ to the millimetre (as the shipped OBJ files are)."""
+    if path.suffix == ".obj":
+        return path.stat().st_size
+    beside = path.with_name(path.name.replace(".city.json", ".obj"))
+    if beside.is_file():
+        return beside.stat().st_size
+    lines = [f"v {x:.3f} {y:.3f} {z:.3f}" for x, y, z in truth.vertices]
+    lines += [f"f {a + 1} {b + 1} {c + 1}" for a, b, c in truth.faces]
+    return len(("\n".join(lines) + "\n").encode())
+
+
+def folder_bytes(folder: Path) -> int:
+    return sum(p.stat().st_size for p in folder.iterdir()) if folder.is_dir() else 0
+
+
+def levels(path: Path, truth: trimesh.Trimesh, obj: int) -> list[str]:
+    """Each level above 0: grammar + assets against the OBJ, and the Chamfer distance (mean of
+    the two one-way mean distances) of its derived OBJ to the input, measured by trimesh."""
+    rows, level = [], 1
+    while True:
+        with tempfile.TemporaryDirectory() as tmp:
+            grammar = Path(tmp) / "city.bgr"
+            try:
+                bgr("infer", str(path), "--no-progress", "--level", str(level), "-o", str(grammar))
+            except SystemExit:
+                return rows  # past the coarsest level
+            size = grammar.stat().st_size + folder_bytes(Path(tmp) / "city.assets")
+            out = Path(tmp) / "out.obj"
+            bgr("derive", str(grammar), "-o", str(out))
+            mesh = read_output(out)
+            chamfer = (distances(truth, mesh).mean() + distances(mesh, truth).mean()) / 2
+            rows.append(f"| {path.name} | {level} | {size:,} | {obj / size:.1f} | {chamfer:.3f} |")
+        level += 1
 
 
 def main() -> None:
-    files = [Path(a) for a in sys.argv[1:]] or sorted(
+    flags = {a for a in sys.argv[1:] if a.startswith("--")}
+    files = [Path(a) for a in sys.argv[1:] if not a.startswith("--")] or sorted(
         p for p in CITIES.iterdir() if p.suffix in (".obj", ".json")
     )
-    rows, sizes = [], []
+    rows, sizes, coarse = [], [], []
     for path in files:
         truth = read_input(path)
+        obj = obj_bytes(path, truth)
         with tempfile.TemporaryDirectory() as tmp:
             grammar = Path(tmp) / "city.bgr"
             bgr("infer", str(path), "--no-progress", "-o", str(grammar))
-            assets = sum(p.stat().st_size for p in (Path(tmp) / "city.assets").iterdir())
+            assets = folder_bytes(Path(tmp) / "city.assets")
             text = grammar.stat().st_size
             size = path.stat().st_size
             sizes.append(
-                f"| {path.name} | {size:,} | {text:,} | {assets:,} | {(text + assets) / size:.2f} |"
+                f"| {path.name} | {size:,} | {obj:,} | {text:,} | {assets:,} | "
+                f"{(text + assets) / obj:.2f} |"
             )
             site = next(
                 (line for line in grammar.read_text().splitlines() if line.startswith("site ")),
@@ -98,12 +145,19 @@ def main() -> None:
                 distance = max(one_way(truth, mesh), one_way(mesh, truth))
                 offset = float(np.abs(mesh.bounds[0] - truth.bounds[0]).max())
                 rows.append(f"| {path.name} | `{site}` | .{ext} | {distance:.4f} | {offset:.4f} |")
-    print("| input | input bytes | grammar bytes | assets bytes | (grammar + assets) / input |")
-    print("|---|---|---|---|---|")
+        if "--levels" in flags:
+            coarse += levels(path, truth, obj)
+    head = "| input | input bytes | OBJ bytes | grammar bytes | assets bytes |"
+    print(head + " (grammar + assets) / OBJ |")
+    print("|---|---|---|---|---|---|")
     print("\n".join(sizes) + "\n")
     print("| input | site line | output | Hausdorff (m) | lowest corner offset (m) |")
     print("|---|---|---|---|---|")
     print("\n".join(rows))
+    if coarse:
+        print("\n| input | level | grammar + assets bytes | OBJ / that | Chamfer (m) |")
+        print("|---|---|---|---|---|")
+        print("\n".join(coarse))
 
 
 if __name__ == "__main__":

@@ -32,6 +32,7 @@ from .registry import (
     FOOTPRINT_KINDS,
     GEOMETRY,
     KEYWORDS,
+    MANY,
     NORMALIZE_MODE,
     NORMALIZE_MODES,
     NORMALIZE_TYPE,
@@ -415,7 +416,8 @@ class Checker:
         op = OPERATIONS[step.name]
         signature = self.pick_signature(op, step)
         if signature is not None:
-            for arg, param in zip(step.args, signature, strict=False):
+            for i, arg in enumerate(step.args):
+                param = op.param(signature, i)
                 self.op_arg(arg, param.kind, param.name, op, local)
         else:
             # no signature fits (reported): check the expressions, but not a bare word that one
@@ -457,7 +459,10 @@ class Checker:
         for sig, (least, most) in zip(op.signatures, op.arities(), strict=True):
             if least <= count <= most:
                 return sig
-        counts = " or ".join(str(a) if a == b else f"{a} to {b}" for a, b in op.arities())
+        counts = " or ".join(
+            str(a) if a == b else f"{a} or more" if b == MANY else f"{a} to {b}"
+            for a, b in op.arities()
+        )
         noun = "argument" if counts == "1" else "arguments"
         self.error(
             step.pos,

@@ -56,6 +56,7 @@ NORMALIZE_TYPES = ("separatePerFace", "collectiveAllFaces")
 UV_SETS = 10  # uv-sets 0..9, as CGA's texture layers (material.colormap is 0, normalmap 5)
 
 REQUIRED = object()
+MANY = 1 << 20  # "any number of arguments": an operation whose last parameters repeat
 
 
 @dataclass(frozen=True)
@@ -73,18 +74,24 @@ class Op:
     doc: str
     example: str
     block: str | None = None  # None, or the kind of block it takes: split | comp | offset
+    more: Param | None = None  # what any number of further arguments are (polygon's corners)
 
     def arities(self) -> list[tuple[int, int]]:
         """(least, most) argument counts of each signature."""
         out = []
         for sig in self.signatures:
             least = sum(1 for p in sig if p.default is REQUIRED)
-            out.append((least, len(sig)))
+            out.append((least, MANY if self.more else len(sig)))
         return out
 
+    def param(self, sig: tuple[Param, ...], index: int) -> Param:
+        """The parameter that argument ``index`` of a call matching ``sig`` fills."""
+        return sig[index] if index < len(sig) or self.more is None else self.more
+
     def usage(self) -> str:
+        tail = f", {self.more.name}" if self.more else ""
         return " or ".join(
-            f"{self.name}({', '.join(p.name for p in sig)})" for sig in self.signatures
+            f"{self.name}({', '.join(p.name for p in sig)}{tail})" for sig in self.signatures
         )
 
 
@@ -182,6 +189,17 @@ OPERATIONS: dict[str, Op] = {
             "`T`, `cross` (wing widths `a`, `b` as fractions of the scope; `b` defaults to `a`), "
             "`circle` (`a` sides, at least 3 when given).",
             "footprint(L, 0.4, 0.5)",
+        ),
+        Op(
+            "polygon",
+            "components",
+            _sig(*(Param(f"{a}{i}", NUMBER) for i in (1, 2, 3) for a in "xz")),
+            "Replace a horizontal 2D shape (a lot, or a piece of one) by the polygon through the "
+            "corners given as x, z pairs, in metres in the scope's frame (three corners or more, "
+            "not crossing; either way round). The scope keeps its axes and becomes the "
+            "polygon's bounding box. `bgr infer --kind city` writes footprints with it.",
+            "polygon(0, 0, 12, 0, 12, 8, 5, 8, 5, 14, 0, 14)",
+            more=Param("...", NUMBER),
         ),
         Op(
             "extrude",

@@ -556,7 +556,8 @@ class Application:
             if least <= count <= most
         )
         plan = []
-        for i, param in enumerate(sig):
+        for i in range(max(len(sig), count)):
+            param = spec.param(sig, i)
             numeric = param.kind in _NUMERIC_KINDS
             if i >= count:
                 plan.append((0, param.default, None, numeric))

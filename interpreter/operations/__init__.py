@@ -20,6 +20,7 @@ IMPLEMENTATIONS = {
     "offset": components.offset,
     "extrude": components.extrude,
     "footprint": components.footprint,
+    "polygon": components.polygon,
     "taper": components.taper,
     "roof": roofs.roof,
     "i": inserts.insert,

@@ -5,6 +5,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
+import shapely
 
 from bgr.grammar import nodes as n
 
@@ -338,6 +339,61 @@ def footprint(app, shape, step, args) -> bool:
                 )
     polys = named_footprint(kind, a, b)
     shape.geom = Flat(geom.k, RECT if kind == "rect" else polys)
+    return False
+
+
+def polygon(app, shape, step, args) -> bool:
+    """Swap a horizontal 2D shape for the polygon through the given corners (x, z pairs in
+    metres, in the scope's frame): how an inferred city writes a footprint it extrudes, and a
+    way to hand-write one.  The scope keeps its axes and shrinks to the polygon's bounding box."""
+    geom = _flat(app, step, shape)
+    if geom.k != 1:
+        raise runtime_error(
+            app.module,
+            step.pos,
+            "polygon() needs a horizontal 2D shape, and this face is upright",
+            "give the corners on a lot (or a piece of one), then extrude",
+        )
+    values = args[:-1]
+    for i, value in enumerate(values):
+        if isinstance(value, bool) or not isinstance(value, (int, float)):
+            raise runtime_error(
+                app.module,
+                step.pos,
+                f"polygon() needs numbers, got {value!r:.40} (argument {i + 1})",
+            )
+    if len(values) % 2:
+        raise runtime_error(
+            app.module,
+            step.pos,
+            f"polygon() takes x, z pairs, and {len(values)} numbers leave one over",
+            "write the corners as polygon(x1, z1, x2, z2, x3, z3, ...)",
+        )
+    ring = [(float(x), float(z)) for x, z in zip(values[0::2], values[1::2], strict=True)]
+    if len(ring) > 3 and ring[0] == ring[-1]:
+        ring.pop()  # a closed ring, as GeoJSON writes one
+    area = signed_area(ring) if len(ring) >= 3 else 0.0
+    if abs(area) < 1e-9:
+        raise runtime_error(
+            app.module,
+            step.pos,
+            "polygon() needs three corners or more around a non-zero area",
+            "corners that all lie on one line make no footprint",
+        )
+    if not shapely.Polygon(ring).is_valid:
+        raise runtime_error(
+            app.module,
+            step.pos,
+            "polygon()'s edges cross each other or touch",
+            "list the corners in order round the outline, each once",
+        )
+    if area < 0:  # clockwise: walk it the other way, so the caps of an extrusion face outward
+        ring.reverse()
+    unit, (u0, w0, width, depth) = normalise_polys([(tuple(ring), ())])
+    x, z = shape.axes[0], shape.axes[2]
+    shape.origin = tuple(shape.origin[i] + u0 * x[i] + w0 * z[i] for i in range(3))
+    shape.size = [width, 0.0, depth]
+    shape.geom = Flat(1, RECT if is_unit_square(unit) else unit)
     return False
 
 

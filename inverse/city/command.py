@@ -87,12 +87,18 @@ def run(args) -> int:
     write(grammar, text, output, assets_dir, keep=(Path(args.input),))
     placed = grammar.placed
     wrote = "" if output is None else f"; wrote {terminal_text(str(output), keep='')}"
+    extruded = sum(t.prism is not None for t in placed.terminals)
+    meshes = len(placed.terminals) - extruded + len(placed.carried)
     print(
         f"{terminal_text(args.input, keep='')}: {len(grammar.scene.objects)} objects, "
         f"{len(grammar.comps)} components, {len(placed.terminals)} types at level "
-        f"{placed.level.index}, {len(placed.rules)} rules{wrote} and "
-        f"{len(placed.terminals) + len(placed.carried)} meshes in "
-        f"{terminal_text(str(assets_dir / MESHES), keep='')}",
+        f"{placed.level.index} ({extruded} footprints extruded), {len(placed.rules)} "
+        f"rules{wrote}"
+        + (
+            f" and {meshes} meshes in {terminal_text(str(assets_dir / MESHES), keep='')}"
+            if meshes
+            else ""
+        ),
         file=sys.stderr,
     )
     if args.stats:

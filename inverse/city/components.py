@@ -28,6 +28,12 @@ def key_grid(tolerance: float) -> float:
     return tolerance / np.sqrt(3.0)
 
 
+def digits_for(tolerance: float) -> int:
+    """Decimals of the grammar's lengths: a tenth of the tolerance (millimetres for 1 cm), so
+    that rounding them adds at most a few per cent of it."""
+    return int(min(9, max(3, np.ceil(-np.log10(tolerance / 10)))))
+
+
 KEY_GRID = key_grid(TOLERANCE)
 
 # the feature vector (paper, section IV.C), in units where 1 is a noticeable difference

@@ -14,6 +14,7 @@ import numpy as np
 
 from bgr.grammar import nodes as n
 
+from .prisms import PrismFit
 from .tree import Placement, Rule
 
 DEFAULT_LOT = 20.0  # the interpreter's default lot is a 20 m square (LANGUAGE.md section 4)
@@ -28,6 +29,7 @@ class Terminal:
     path: str  # relative to the grammar
     color: str | None
     comment: str
+    prism: PrismFit | None = None  # written as polygon() extrude(), with no asset
 
 
 @dataclass
@@ -52,22 +54,6 @@ def num(x: float, digits: int = 6) -> n.Expr:
     return n.Number(value)
 
 
-def matrix(angle: float, offset: np.ndarray) -> n.Operation:
-    """``matrix(...)``: a turn about the vertical by ``angle`` degrees and a translation, as the
-    3x4 row-major matrix whose columns are the child's axes in the parent's frame."""
-    a = np.radians(angle)
-    return _matrix(float(np.cos(a)), float(np.sin(a)), [float(v) for v in offset[:3]])
-
-
-def _matrix(c: float, s: float, offset: list[float]) -> n.Operation:
-    """:func:`matrix` from the turn's cosine and sine and the offset, as Python floats."""
-    cos, sin, minus_sin = _num(c, 9), _num(s, 9), _num(-s, 9)
-    args = [cos, n.Number(0.0), sin, _num(offset[0], 6)]
-    args += [n.Number(0.0), n.Number(1.0), n.Number(0.0), _num(offset[1], 6)]
-    args += [minus_sin, n.Number(0.0), _num(c, 9), _num(offset[2], 6)]
-    return n.Operation("matrix", args)
-
-
 def _num(value: float, digits: int) -> n.Expr:
     """:func:`num` of a Python float."""
     value = round(value, digits)
@@ -80,26 +66,44 @@ def placement(p: Placement) -> n.Push:
     return placements([p])[0]
 
 
-def placements(found: list[Placement]) -> list[n.Push]:
-    """``[ matrix(...) s(...) Rule ]`` of each placement: the turns' sines and cosines of all
-    at once (a city's axiom places every building: 100,000 of them is ordinary)."""
+@dataclass(frozen=True)
+class Style:
+    """How placements are written: lengths to ``digits`` decimals (millimetres for the default
+    1 cm tolerance), and ``sizeless`` the rules that make their own size (a polygon(), or at
+    level 0 a mesh inserted at its own size), whose placements carry no ``s()``."""
+
+    digits: int = 6
+    sizeless: frozenset[str] = frozenset()
+
+
+def placements(found: list[Placement], style: Style = Style()) -> list[n.Push]:
+    """``[ t(x, y, z) r(0, a, 0) s(...) Rule ]`` of each placement (a move or a turn left out
+    where it is none, the size where the rule makes its own): the numbers of all at once (a
+    city's axiom places every building: 100,000 is ordinary)."""
     if not found:
         return []
-    a = np.radians(np.array([p.angle for p in found], dtype=np.float64))
-    cos, sin = np.cos(a).tolist(), np.sin(a).tolist()
-    offsets = np.array([p.offset[:3] for p in found], dtype=np.float64).reshape(-1, 3).tolist()
+    digits = style.digits
+    angles = np.array([p.angle for p in found], dtype=np.float64)
+    angles = np.round((angles + 180.0) % 360.0 - 180.0, digits + 1)  # in [-180, 180)
+    offsets = np.round(np.array([p.offset[:3] for p in found], dtype=np.float64), digits)
     out = []
-    for p, c, s, offset in zip(found, cos, sin, offsets, strict=True):
-        steps: list = [_matrix(c, s, offset)]
-        if p.size is not None:
-            steps.append(n.Operation("s", [num(v) for v in p.size]))
+    for p, angle, offset in zip(
+        found, angles.tolist(), offsets.reshape(-1, 3).tolist(), strict=True
+    ):
+        steps: list = []
+        if any(offset):
+            steps.append(n.Operation("t", [_num(v, digits) for v in offset]))
+        if angle:
+            steps.append(n.Operation("r", [n.Number(0.0), _num(angle, digits + 1), n.Number(0.0)]))
+        if p.size is not None and p.rule not in style.sizeless:
+            steps.append(n.Operation("s", [num(v, digits) for v in p.size]))
         steps.append(n.Successor(p.rule))
         out.append(n.Push(steps))
     return out
 
 
-def rule(name: str, found: list[Placement]) -> n.Rule:
-    return n.Rule(name, [], n.Sequence(placements(found) or [n.Nil()]))
+def rule(name: str, found: list[Placement], style: Style = Style()) -> n.Rule:
+    return n.Rule(name, [], n.Sequence(placements(found, style) or [n.Nil()]))
 
 
 def module(
@@ -110,9 +114,14 @@ def module(
     units: list[Unit],
     carried: list[tuple[Terminal, Placement]],
     site: n.Site | None = None,
+    *,
+    exact: bool = False,
+    digits: int = 6,
 ) -> n.Module:
     """The whole grammar, laid out in groups with comments (see :func:`_laid_out`); ``site``
-    first, where the input has one (its CRS, up axis and the offset of its coordinates)."""
+    first, where the input has one (its CRS, up axis and the offset of its coordinates).
+    ``exact`` (level 0): every instance of a type has its size, so a mesh is inserted at its
+    own size (``s(0, 0, 0)``) and no placement says it again."""
     axiom = n.Rule(
         "Lot",
         [],
@@ -130,10 +139,16 @@ def module(
             ]
         ),
     )
+    own = terminals + [c for c, _ in carried]
+    style = Style(digits, frozenset(t.name for t in own if exact or t.prism is not None))
     placed: list[tuple[list[str], n.Item]] = [] if site is None else [([], site)]
     groups: list[list[tuple[list[str], n.Item]]] = [
         placed,
-        [([], n.Asset(t.asset, t.path)) for t in terminals + [c for c, _ in carried]],
+        [
+            ([], n.Asset(t.asset, t.path))
+            for t in terminals + [c for c, _ in carried]
+            if t.prism is None
+        ],
         [
             (
                 [
@@ -143,21 +158,53 @@ def module(
                 ],
                 axiom,
             ),
-            ([], rule("City", city + [p for _, p in carried])),
+            ([], rule("City", city + [p for _, p in carried], style)),
         ],
         _synthesis(units),
-        [([f"# {r.comment}"] if r.comment else [], rule(r.name, r.children)) for r in rules],
-        [([f"# {t.comment}"], _terminal_rule(t)) for t in terminals],
-        [([f"# {t.comment}"], _terminal_rule(t)) for t, _ in carried],
+        [([f"# {r.comment}"] if r.comment else [], rule(r.name, r.children, style)) for r in rules],
+        [([f"# {t.comment}"], _terminal_rule(t, exact, digits)) for t in terminals],
+        [([f"# {t.comment}"], _terminal_rule(t, exact, digits)) for t, _ in carried],
     ]
     return _laid_out(header, groups)
 
 
-def _terminal_rule(t: Terminal) -> n.Rule:
+def _terminal_rule(t: Terminal, own_size: bool = False, digits: int = 6) -> n.Rule:
+    """``i(asset)`` (at the asset's own size where ``own_size``: ``s(0, 0, 0)`` first, as in
+    CGA), or a footprint's ``polygon() extrude()``; its colour first where it has one."""
+    if t.prism is not None:
+        return n.Rule(t.name, [], n.Sequence(_prism_steps(t.name, t.prism, digits)))
     steps: list = [n.Operation("i", [n.Name(t.asset)])]
+    if own_size:
+        steps.insert(0, n.Operation("s", [n.Number(0.0)] * 3))
     if t.color:
         steps.insert(0, n.Operation("color", [n.String(t.color)]))
     return n.Rule(t.name, [], n.Sequence(steps))
+
+
+def _prism_steps(name: str, prism: PrismFit, digits: int) -> list:
+    """``polygon(...) extrude(h)``, with ``comp(f) { side: ... | bottom: ... }`` keeping only
+    the faces the component has, and its colours (one a part)."""
+    corners = [num(c, digits) for corner in prism.ring for c in corner]
+    height = num(prism.height, digits)
+    steps: list = [n.Operation("polygon", corners), n.Operation("extrude", [height])]
+    colors = prism.colors
+    parts = ["side"] + [p for p, has in (("bottom", prism.bottom), ("top", prism.top)) if has]
+    one = {colors.get(p) for p in parts}
+    if len(parts) == 3 and len(one) == 1:  # the whole prism, in one colour or none
+        if colors:
+            steps.insert(0, n.Operation("color", [n.String(colors["side"])]))
+        return steps
+    entries = []
+    for part in parts:
+        paint = colors.get(part)
+        body = n.Operation("color", [n.String(paint)]) if paint else _label(name)
+        entries.append(n.Entry("abs", n.Name(part), n.Sequence([body])))
+    steps.append(n.Operation("comp", [n.Name("f")], n.Block(entries)))
+    return steps
+
+
+def _label(name: str) -> n.Operation:
+    return n.Operation("label", [n.String(name)])
 
 
 def _synthesis(units: list[Unit]) -> list[tuple[list[str], n.Item]]:

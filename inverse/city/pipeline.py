@@ -25,8 +25,10 @@ from bgr.interpreter.limits import check_memory, restart_memory
 
 from . import emit, tree
 from .batch import building_stacks, decompose_all
-from .components import TOLERANCE, Component, key_grid
+from .components import TOLERANCE, Component, digits_for, key_grid
+from .container import pack
 from .model import CityScene
+from .prisms import fit_prism
 from .types import Level, Types, cluster, level_for
 
 MESHES = "meshes.glb"  # the one file of the assets folder: every type's mesh, a node each
@@ -127,6 +129,10 @@ def place(
     for i, t in enumerate(order):
         rep = comps[types.base_first[level.representative[t]]]
         low, high = low_of[t], high_of[t]
+        # a type whose instances are all its representative's size may be written as the
+        # operations that make it; one whose instances differ is a mesh fitted to each box
+        same = bool(np.all(high - low <= key_grid(options.tolerance)))
+        prism = fit_prism(rep, options.tolerance) if same else None
         span = " x ".join(
             f"{a:.1f}" if abs(a - b) < 0.05 else f"{a:.1f}-{b:.1f}"
             for a, b in zip(low, high, strict=True)
@@ -137,8 +143,10 @@ def place(
                 f"type{i + 1}",
                 f"{options.assets}/{MESHES}#type{i + 1}",
                 _colour(rep),
-                f"component type {i + 1}: {_count(int(count[t]), 'instance')}, "
-                f"{span} m (width x height x depth)",
+                (f"{count[t]} instances, " if count[t] > 1 else "")
+                + f"{span} m"
+                + (", a footprint extruded" if prism else ""),
+                prism,
             )
         )
         term_mesh.append(rep)
@@ -169,8 +177,7 @@ def place(
                 name,
                 children,
                 len(found),
-                f"building kind {k + 1}: {_count(len(found), 'instance')}, "
-                f"{_count(len(children), 'component')}",
+                f"{len(found)} instances" if len(found) > 1 else "",
             )
         )
         low, high = _extent(children)
@@ -217,8 +224,7 @@ def place(
             f"object{len(carried) + 1}",
             f"{options.assets}/{MESHES}#object{len(carried) + 1}",
             _colour_of(obj.colors),
-            f"carried through as it is: {comment_text(obj.kind, 60)} {comment_text(obj.name)} "
-            f"({len(obj.faces)} triangles)",
+            f"{comment_text(obj.kind, 60)} {comment_text(obj.name)}, carried as it is",
         )
         size = obj.vertices.max(axis=0) - low
         carried.append(
@@ -314,22 +320,15 @@ def _colour_of(colors: np.ndarray | None) -> str | None:
     return f"#{int(r):02x}{int(g):02x}{int(b):02x}"
 
 
-def _mesh(vertices: np.ndarray, faces: np.ndarray) -> trimesh.Trimesh:
-    """A type's mesh with its equal vertices shared (equal to 1e-8 m: trimesh's merge)."""
-    mesh = trimesh.Trimesh(np.asarray(vertices, dtype=np.float64), np.asarray(faces), process=False)
+def _merged(vertices: np.ndarray, faces: np.ndarray, digits: int) -> tuple[np.ndarray, np.ndarray]:
+    """A mesh on the grammar's grid (``digits`` decimals: the lengths written are as short as
+    the grammar's), its equal vertices shared and the ones no triangle uses dropped."""
+    points = np.round(np.asarray(vertices, dtype=np.float64), digits)
+    mesh = trimesh.Trimesh(points, np.asarray(faces), process=False)
     mesh.merge_vertices()
-    return mesh
-
-
-def _exported(scene: trimesh.Scene) -> bytes:
-    """Every type's mesh in one GLB (trimesh's exporter), a node per mesh named as the grammar's
-    asset is (``meshes.glb#type1``), without normals: bgr derives flat-shaded faces from the
-    triangles (with the merged vertices of :func:`_mesh`, 0.78 times the file trimesh writes
-    by default on Zurich's LoD2 tile: 364,904 bytes against 467,744)."""
-    from trimesh.exchange.gltf import export_glb
-
-    out = export_glb(scene, include_normals=False)
-    return bytes(out) if not isinstance(out, bytes) else out
+    mesh.update_faces(mesh.nondegenerate_faces())  # a corner merged into another
+    mesh.remove_unreferenced_vertices()
+    return np.asarray(mesh.vertices), np.asarray(mesh.faces)
 
 
 def _reading_cost(path: str | Path) -> int:
@@ -378,15 +377,17 @@ def infer_city(
 def build(
     scene: CityScene, comps: list[Component], types: Types, placed: Placed, options: Options
 ) -> CityGrammar:
-    container = trimesh.Scene()
+    named = []
+    digits = digits_for(options.tolerance)
     with _bar(options, len(placed.terminals) + len(placed.carried), "writing meshes") as bar:
         for t, rep in zip(placed.terminals, placed.term_mesh, strict=True):
-            container.add_geometry(_mesh(rep.vertices, rep.faces), t.asset, t.asset)
+            if t.prism is None:  # a footprint extruded is written as operations, not a mesh
+                named.append((t.asset, *_merged(rep.vertices, rep.faces, digits)))
             bar.update()
         for t, _, vertices, faces in placed.carried:
-            container.add_geometry(_mesh(vertices, faces), t.asset, t.asset)
+            named.append((t.asset, *_merged(vertices, faces, digits)))
             bar.update()
-    assets = {MESHES: _exported(container)} if container.geometry else {}
+    assets = {MESHES: pack(named, "bgr infer --kind city")} if named else {}
     header = _header(scene, comps, types, placed)
     module = emit.module(
         header,
@@ -396,17 +397,22 @@ def build(
         placed.units,
         [(t, p) for t, p, _, _ in placed.carried],
         site_of(scene),
+        exact=placed.level.index == 0,
+        digits=digits,
     )
     return CityGrammar(module, assets, scene, comps, placed, types)
 
 
 def _header(scene: CityScene, comps: list[Component], types: Types, placed: Placed) -> list[str]:
+    extruded = sum(t.prism is not None for t in placed.terminals)
     lines = [
         f"# Inferred by bgr infer --kind city from {comment_text(Path(scene.source).name)}: "
         f"{len(scene.objects)} objects,",
         f"# {len(comps)} components in {len(placed.terminals)} types (level "
         f"{placed.level.index} of {len(types.levels) - 1}), {len(placed.rules)} non-terminal "
-        "rules.",
+        "rules;",
+        f"# {extruded} of the types are footprints extruded (polygon, extrude), the others meshes;",
+        "# a type's comment gives its size (width x height x depth) and instances where several.",
     ]
     if site_of(scene) is not None:
         lines.append(
