@@ -20,6 +20,7 @@ third: every level above 0, its size against the OBJ and its Chamfer distance to
 from __future__ import annotations
 
 import json
+import re
 import subprocess
 import sys
 import tempfile
@@ -91,6 +92,26 @@ def obj_bytes(path: Path, truth: trimesh.Trimesh) -> int:
     return len(("\n".join(lines) + "\n").encode())
 
 
+def buildings_obj(path: Path, out: Path) -> bool:
+    """The input's buildings alone (what bgr proceduralizes; roads, terrain and water are
+    carried as they are) as OBJ, an ``o`` per building, to the millimetre in the input's frame;
+    False when the input has nothing else."""
+    from bgr.inverse.city.read import read_city
+
+    scene = read_city(str(path))
+    kept = [o for o in scene.objects if o.proceduralize]
+    if len(kept) == len(scene.objects):
+        return False
+    lines, base = [], 1
+    for o in kept:
+        lines.append(f"o {o.name}")
+        lines += [f"v {x:.3f} {y:.3f} {z:.3f}" for x, y, z in scene.to_input(o.vertices)]
+        lines += [f"f {a + base} {b + base} {c + base}" for a, b, c in o.faces]
+        base += len(o.vertices)
+    out.write_text("\n".join(lines) + "\n")
+    return True
+
+
 def folder_bytes(folder: Path) -> int:
     return sum(p.stat().st_size for p in folder.iterdir()) if folder.is_dir() else 0
 
@@ -98,14 +119,14 @@ def folder_bytes(folder: Path) -> int:
 def levels(path: Path, truth: trimesh.Trimesh, obj: int) -> list[str]:
     """Each level above 0: grammar + assets against the OBJ, and the Chamfer distance (mean of
     the two one-way mean distances) of its derived OBJ to the input, measured by trimesh."""
-    rows, level = [], 1
-    while True:
+    rows, level, last = [], 1, 1
+    while level <= last:
         with tempfile.TemporaryDirectory() as tmp:
             grammar = Path(tmp) / "city.bgr"
-            try:
-                bgr("infer", str(path), "--no-progress", "--level", str(level), "-o", str(grammar))
-            except SystemExit:
-                return rows  # past the coarsest level
+            bgr("infer", str(path), "--no-progress", "--level", str(level), "-o", str(grammar))
+            # the header says "(level L of M)": a level past M is M again
+            found = re.search(r"\(level \d+ of (\d+)\)", grammar.read_text())
+            last = int(found.group(1)) if found else level
             size = grammar.stat().st_size + folder_bytes(Path(tmp) / "city.assets")
             out = Path(tmp) / "out.obj"
             bgr("derive", str(grammar), "-o", str(out))
@@ -113,6 +134,7 @@ def levels(path: Path, truth: trimesh.Trimesh, obj: int) -> list[str]:
             chamfer = (distances(truth, mesh).mean() + distances(mesh, truth).mean()) / 2
             rows.append(f"| {path.name} | {level} | {size:,} | {obj / size:.1f} | {chamfer:.3f} |")
         level += 1
+    return rows
 
 
 def main() -> None:
@@ -145,8 +167,19 @@ def main() -> None:
                 distance = max(one_way(truth, mesh), one_way(mesh, truth))
                 offset = float(np.abs(mesh.bounds[0] - truth.bounds[0]).max())
                 rows.append(f"| {path.name} | `{site}` | .{ext} | {distance:.4f} | {offset:.4f} |")
+        with tempfile.TemporaryDirectory() as tmp:
+            alone = Path(tmp) / "buildings.obj"
+            if buildings_obj(path, alone):
+                grammar = Path(tmp) / "city.bgr"
+                bgr("infer", str(alone), "--no-progress", "-o", str(grammar))
+                text, assets = grammar.stat().st_size, folder_bytes(Path(tmp) / "city.assets")
+                obj = alone.stat().st_size
+                sizes.append(
+                    f"| {path.name}, buildings only | | {obj:,} | {text:,} | {assets:,} | "
+                    f"{(text + assets) / obj:.2f} |"
+                )
         if "--levels" in flags:
-            coarse += levels(path, truth, obj)
+            coarse += levels(path, truth, obj_bytes(path, truth))
     head = "| input | input bytes | OBJ bytes | grammar bytes | assets bytes |"
     print(head + " (grammar + assets) / OBJ |")
     print("|---|---|---|---|---|---|")

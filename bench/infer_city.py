@@ -65,16 +65,21 @@ def scale(buildings: int, city: Path) -> None:
     with tempfile.TemporaryDirectory() as tmp:
         seconds, peak, err = run(["infer", str(city), "-o", "city.bgr", "--no-progress"], tmp)
         found = re.search(
-            r"(\d+) objects, (\d+) components, (\d+) types at level 0, (\d+) rules", err
+            r"(\d+) objects, (\d+) components, (\d+) types at level 0 "
+            r"\((\d+) footprints extruded\), (\d+) rules",
+            err,
         )
         lines = (Path(tmp) / "city.bgr").read_text().count("\n")
     print(f"## scale: {city.name} ({city.stat().st_size / 1e6:.1f} MB)")
-    print("| buildings | components | types | rules | grammar lines | time | peak memory |")
-    print("|---|---|---|---|---|---|---|")
+    print(
+        "| buildings | components | types | footprints extruded | rules | grammar lines | time "
+        "| peak memory |"
+    )
+    print("|---|---|---|---|---|---|---|---|")
     if found:
-        b, c, t, r = found.groups()
+        b, c, t, x, r = (int(v) for v in found.groups())
         print(
-            f"| {int(b):,} | {int(c):,} | {int(t):,} | {int(r):,} | {lines:,} | {seconds:.1f} s | "
+            f"| {b:,} | {c:,} | {t:,} | {x:,} | {r:,} | {lines:,} | {seconds:.1f} s | "
             f"{peak:.0f} MB |"
         )
     print()

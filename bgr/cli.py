@@ -228,7 +228,8 @@ def build_parser() -> argparse.ArgumentParser:
         "textured building's style sheet",
         description="Infer a .bgr grammar from data. --kind city (the default for .obj, .ply, "
         ".glb, .gltf and CityJSON inputs): city-scale proceduralization of a 3D city, a "
-        "grammar of component types whose meshes go in an assets folder beside it "
+        "grammar of component types (footprints extruded written as polygon() extrude(), "
+        "other shapes as meshes in one GLB in an assets folder beside it) "
         "(docs/inverse-city.md). --kind schema (the default for other .json and .bgr): "
         "Build-by-Number face, floor and model schemas of a labelled, subdivided "
         "building: a terminal list (bgr derive -o x.json), a captured-model JSON "
@@ -296,7 +297,8 @@ def build_parser() -> argparse.ArgumentParser:
     city.add_argument(
         "--assets",
         metavar="DIR",
-        help="folder for the component meshes (--kind style: the texture crops; default: "
+        help="folder for the component meshes, one meshes.glb (--kind style: the texture "
+        "crops; default: "
         "OUT.assets beside -o OUT.bgr, or ./city.assets (./style.assets) when the grammar goes "
         "to standard output); it must be new, empty or one "
         "bgr wrote (with its .bgr-assets.json), as bgr replaces it whole",

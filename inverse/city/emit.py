@@ -17,6 +17,9 @@ from bgr.grammar import nodes as n
 from .prisms import PrismFit
 from .tree import Placement, Rule
 
+# the faces of an extruded footprint that comp(f) keeps, as terminals named after CityGML's
+# WallSurface, RoofSurface and GroundSurface
+SURFACES = {"side": "Wall", "top": "Roof", "bottom": "Ground"}
 DEFAULT_LOT = 20.0  # the interpreter's default lot is a 20 m square (LANGUAGE.md section 4)
 
 
@@ -142,6 +145,8 @@ def module(
     own = terminals + [c for c, _ in carried]
     style = Style(digits, frozenset(t.name for t in own if exact or t.prism is not None))
     placed: list[tuple[list[str], n.Item]] = [] if site is None else [([], site)]
+    if any(_split_faces(t.prism) for t in terminals if t.prism is not None):
+        placed.append(([], n.TerminalDecl(list(SURFACES.values()))))
     groups: list[list[tuple[list[str], n.Item]]] = [
         placed,
         [
@@ -162,17 +167,26 @@ def module(
         ],
         _synthesis(units),
         [([f"# {r.comment}"] if r.comment else [], rule(r.name, r.children, style)) for r in rules],
-        [([f"# {t.comment}"], _terminal_rule(t, exact, digits)) for t in terminals],
+        [
+            ([f"# {t.comment}"] if t.comment else [], _terminal_rule(t, exact, digits))
+            for t in terminals
+        ],
         [([f"# {t.comment}"], _terminal_rule(t, exact, digits)) for t, _ in carried],
     ]
     return _laid_out(header, groups)
+
+
+def _split_faces(prism: PrismFit) -> bool:
+    """Whether a prism is written with comp(f): it lacks a cap, or its parts differ in colour."""
+    parts = ["side"] + [p for p, has in (("bottom", prism.bottom), ("top", prism.top)) if has]
+    return len(parts) < 3 or len({prism.colors.get(p) for p in parts}) > 1
 
 
 def _terminal_rule(t: Terminal, own_size: bool = False, digits: int = 6) -> n.Rule:
     """``i(asset)`` (at the asset's own size where ``own_size``: ``s(0, 0, 0)`` first, as in
     CGA), or a footprint's ``polygon() extrude()``; its colour first where it has one."""
     if t.prism is not None:
-        return n.Rule(t.name, [], n.Sequence(_prism_steps(t.name, t.prism, digits)))
+        return n.Rule(t.name, [], n.Sequence(_prism_steps(t.prism, digits)))
     steps: list = [n.Operation("i", [n.Name(t.asset)])]
     if own_size:
         steps.insert(0, n.Operation("s", [n.Number(0.0)] * 3))
@@ -181,30 +195,28 @@ def _terminal_rule(t: Terminal, own_size: bool = False, digits: int = 6) -> n.Ru
     return n.Rule(t.name, [], n.Sequence(steps))
 
 
-def _prism_steps(name: str, prism: PrismFit, digits: int) -> list:
-    """``polygon(...) extrude(h)``, with ``comp(f) { side: ... | bottom: ... }`` keeping only
-    the faces the component has, and its colours (one a part)."""
+def _prism_steps(prism: PrismFit, digits: int) -> list:
+    """``polygon(...) extrude(h)``, with ``comp(f) { side: Wall | top: Roof }`` keeping only
+    the faces the component has (named as CityGML names its surfaces), and its colours (one
+    a part)."""
     corners = [num(c, digits) for corner in prism.ring for c in corner]
     height = num(prism.height, digits)
     steps: list = [n.Operation("polygon", corners), n.Operation("extrude", [height])]
     colors = prism.colors
     parts = ["side"] + [p for p, has in (("bottom", prism.bottom), ("top", prism.top)) if has]
-    one = {colors.get(p) for p in parts}
-    if len(parts) == 3 and len(one) == 1:  # the whole prism, in one colour or none
+    if not _split_faces(prism):  # the whole prism, in one colour or none
         if colors:
             steps.insert(0, n.Operation("color", [n.String(colors["side"])]))
         return steps
     entries = []
     for part in parts:
         paint = colors.get(part)
-        body = n.Operation("color", [n.String(paint)]) if paint else _label(name)
-        entries.append(n.Entry("abs", n.Name(part), n.Sequence([body])))
+        body: list = [n.Successor(SURFACES[part])]
+        if paint:
+            body.insert(0, n.Operation("color", [n.String(paint)]))
+        entries.append(n.Entry("abs", n.Name(part), n.Sequence(body)))
     steps.append(n.Operation("comp", [n.Name("f")], n.Block(entries)))
     return steps
-
-
-def _label(name: str) -> n.Operation:
-    return n.Operation("label", [n.String(name)])
 
 
 def _synthesis(units: list[Unit]) -> list[tuple[list[str], n.Item]]:

@@ -143,9 +143,11 @@ def place(
                 f"type{i + 1}",
                 f"{options.assets}/{MESHES}#type{i + 1}",
                 _colour(rep),
-                (f"{count[t]} instances, " if count[t] > 1 else "")
-                + f"{span} m"
-                + (", a footprint extruded" if prism else ""),
+                # an extrusion's numbers say its size; a mesh's comment says it
+                ", ".join(
+                    ([f"{count[t]} instances"] if count[t] > 1 else [])
+                    + ([] if prism else [f"{span} m"])
+                ),
                 prism,
             )
         )
@@ -412,7 +414,8 @@ def _header(scene: CityScene, comps: list[Component], types: Types, placed: Plac
         f"{placed.level.index} of {len(types.levels) - 1}), {len(placed.rules)} non-terminal "
         "rules;",
         f"# {extruded} of the types are footprints extruded (polygon, extrude), the others meshes;",
-        "# a type's comment gives its size (width x height x depth) and instances where several.",
+        "# a mesh type's comment gives its size (width x height x depth), and any type's its "
+        "instances where several.",
     ]
     if site_of(scene) is not None:
         lines.append(

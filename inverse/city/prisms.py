@@ -61,7 +61,7 @@ def fit_prism(comp: Component, tolerance: float) -> PrismFit | None:
     top = real & (up > LEVEL) & (np.abs(ys - height).max(axis=1) <= half)
     if not np.all(wall | bottom | top | ~real) or not wall.any():
         return None
-    outline = _outline(tri[wall][:, :, [0, 2]], tolerance)
+    outline = _outline(_ground_lines(tri[wall], half), tolerance)
     if outline is None:
         return None
     digits = digits_for(tolerance)
@@ -127,10 +127,20 @@ def _close(comp: Component, fit: PrismFit, tolerance: float) -> bool:
     return True
 
 
-def _outline(walls: np.ndarray, tolerance: float):
-    """The one polygon the walls stand on (seen from above each wall is a segment), or None
-    when they enclose several or a courtyard (a hole ``polygon()`` cannot write)."""
-    ends = _segment_ends(walls)
+def _ground_lines(walls: np.ndarray, half: float) -> np.ndarray:
+    """(L, 2, 2): where the walls stand, seen from above: the edges of wall triangles that lie
+    on the slab's bottom (exact even where a wall leans a little), or, where no wall edge is
+    there, each wall triangle's two corners farthest apart."""
+    edges = np.concatenate([walls[:, [0, 1]], walls[:, [1, 2]], walls[:, [2, 0]]])
+    low = np.all(np.abs(edges[:, :, 1]) <= half, axis=1)
+    if low.sum() >= 3:
+        return edges[low][:, :, [0, 2]]
+    return _segment_ends(walls[:, :, [0, 2]])
+
+
+def _outline(ends: np.ndarray, tolerance: float):
+    """The one polygon the ground lines enclose, or None when they enclose several or a
+    courtyard (a hole ``polygon()`` cannot write)."""
     grid = tolerance / 4
     snapped = np.round(ends / grid) * grid
     lines = shapely.linestrings(snapped)
