@@ -1,6 +1,11 @@
 """Benchmark: the grid-city stress grammar derived and written to GLB, against a C++ peer.
 
     python bench/grid_city.py [--sizes 10 20 40] [--grammar ../shared/bench/grid_city.bgr]
+    python bench/grid_city.py --shapeml PATH/ShapeMaker [--pairs 5]
+
+ShapeML builds from its public repository (github.com/stefalie/shapeml) with cmake in Release
+mode (it needs the X11 development packages); ``--shapeml`` times it in the same run, in turn
+with bgr (with reuse, and with BGR_REUSE=0), and prints medians and pair-by-pair ratios.
 
 Each size runs in a fresh Python process (so peak memory is that run's own): load the grammar,
 derive it with n = N, write a GLB.  Prints seconds for each phase, terminals and triangles per
@@ -14,13 +19,16 @@ from __future__ import annotations
 import argparse
 import json
 import os
+import statistics
 import subprocess
 import sys
 import tempfile
+import time
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent.parent
 DEFAULT_GRAMMAR = ROOT.parent / "shared" / "bench" / "grid_city.bgr"
+SHAPEML_GRAMMAR = ROOT.parent / "shared" / "bench" / "grid_city.shp"  # the same city, n = 20
 PEER = {
     "n": 20,
     # ShapeML re-measured on this 2-core machine (the project brief, 2026-11); the figures first
@@ -48,13 +56,14 @@ print(json.dumps({"load_s": t1 - t0, "derive_s": t2 - t1, "write_s": t3 - t2,
 """
 
 
-def run(grammar: Path, n: int) -> dict:
+def run(grammar: Path, n: int, reuse: bool = True) -> dict:
     with tempfile.TemporaryDirectory() as tmp:
         out = Path(tmp) / f"grid_{n}.glb"
         proc = subprocess.run(
             [sys.executable, "-c", CHILD, str(grammar), str(n), str(out)],
             capture_output=True,
             text=True,
+            env={**os.environ, "BGR_REUSE": "1" if reuse else "0"},
         )
         if proc.returncode != 0:
             sys.exit(f"n = {n} failed:\n{proc.stderr}")
@@ -65,11 +74,63 @@ def run(grammar: Path, n: int) -> dict:
     return stats
 
 
+def shapeml(binary: Path, export: bool) -> float:
+    """Seconds of one ShapeMaker run on grid_city.shp (n = 20), whole process."""
+    with tempfile.TemporaryDirectory() as tmp:
+        extra = ["--export-obj", "--export-dir", tmp] if export else []
+        start = time.perf_counter()
+        subprocess.run(
+            [str(binary), "--no-gui", "--seed", "1", *extra, str(SHAPEML_GRAMMAR)],
+            check=True,
+            capture_output=True,
+            cwd=tmp,
+        )
+        return time.perf_counter() - start
+
+
+def against_shapeml(grammar: Path, binary: Path, pairs: int) -> None:
+    """bgr (reuse on, and off) and ShapeML in turn, ``pairs`` times, at n = 20: the medians and
+    the median of the ratios pair by pair (the machine's speed drifts; a pair shares it)."""
+    rows = []
+    for _ in range(pairs):
+        on, off = run(grammar, 20), run(grammar, 20, reuse=False)
+        rows.append((on, off, shapeml(binary, False), shapeml(binary, True)))
+    med = statistics.median
+    print(f"\nbgr vs ShapeML at n = 20, {pairs} rounds (bgr with reuse, without; ShapeML):")
+    print(
+        f"  bgr derive: {med(r[0]['derive_s'] for r in rows):.2f} s with reuse, "
+        f"{med(r[1]['derive_s'] for r in rows):.2f} s without"
+    )
+    print(f"  bgr derive + GLB: {med(r[0]['total_s'] for r in rows):.2f} s with reuse")
+    print(
+        f"  ShapeML derive: {med(r[2] for r in rows):.2f} s; derive + OBJ: "
+        f"{med(r[3] for r in rows):.2f} s"
+    )
+    print(
+        f"  ratio derive / ShapeML derive: {med(r[0]['derive_s'] / r[2] for r in rows):.3f} "
+        f"(without reuse {med(r[1]['derive_s'] / r[2] for r in rows):.2f})"
+    )
+    print(
+        f"  ratio derive + GLB / ShapeML derive + OBJ: "
+        f"{med(r[0]['total_s'] / r[3] for r in rows):.3f}"
+    )
+    print(f"  peak MB: bgr {med(r[0]['peak_mb'] for r in rows):.0f}")
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--sizes", type=int, nargs="+", default=[10, 20, 40])
     ap.add_argument("--grammar", type=Path, default=DEFAULT_GRAMMAR)
+    ap.add_argument(
+        "--shapeml",
+        type=Path,
+        help="ShapeML's ShapeMaker binary: time it against bgr at n = 20 in the same run",
+    )
+    ap.add_argument("--pairs", type=int, default=5, help="rounds against ShapeML")
     args = ap.parse_args()
+    if args.shapeml:
+        against_shapeml(args.grammar, args.shapeml, args.pairs)
+        return
     if not args.grammar.is_file():
         sys.exit(f"{args.grammar}: not found (the benchmark grammar lives in ../shared/bench/)")
     print(f"grammar: {args.grammar}  (cores: {os.cpu_count()})")

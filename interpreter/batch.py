@@ -34,6 +34,7 @@ from dataclasses import dataclass, field, replace
 
 from bgr.grammar.checker import Grammar
 from bgr.grammar.errors import BgrError, Diagnostic, Warnings
+from bgr.grammar.parser import no_gc
 
 from .engine import Engine
 from .limits import default_max_memory, memory_in_use
@@ -102,6 +103,7 @@ def lot_name(lot: Lot, index: int, several: bool) -> str:
     return lot.name or (f"lot {index}" if several else "")
 
 
+@no_gc()  # the engine pauses it while deriving; freezing the table makes as many objects
 def derive_lot(
     job: Job,
     index: int,

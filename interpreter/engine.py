@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import gc
 import math
+import os
 from dataclasses import replace
 
 from bgr.grammar import nodes as n
@@ -49,6 +50,7 @@ from .limits import (
 from .operations import IMPLEMENTATIONS
 from .operations.texturing import follow
 from .randomness import Stream, child_hash, name_hash, root_hash
+from .reuse import Reuse
 from .shapes import Flat, Shape, Solid
 from .terminals import TerminalTable, UnitMesh
 
@@ -70,6 +72,10 @@ _NUMERIC_KINDS = {NUMBER, SIZE, TEX_SIZE}  # parameters whose value must be a nu
 _MOVERS = frozenset({"t", "r", "s", "center", "matrix"})
 _NUMBER = (float, int)  # bool is neither: True.__class__ is bool
 EMIT = object()  # marks a children-list entry that is a finished terminal, kept in order
+RECORDED = object()  # marks the end of a reusable subtree on the stack (reuse.py)
+# derive each repeated subtree once (reuse.py); BGR_REUSE=0 derives every one in full (the
+# same numbers, slower: for tests and measurements)
+REUSE = os.environ.get("BGR_REUSE", "1") != "0"
 _NAME_HASHES: dict[str, int] = {}
 
 
@@ -129,6 +135,7 @@ class Engine:
         self.compilers: dict[int, Compiler] = {}
         self.attrs = self._prepare_values(grammar, dict(attrs or {}))
         self.table = TerminalTable()
+        self.reuse = Reuse(replay=REUSE)
         self.shapes = 0
         self.barren_shapes = 0  # handed to rules that can never end in a terminal (.barren)
         self._bindings: dict = {}
@@ -214,16 +221,40 @@ class Engine:
         lot.path = f"{start}.{index}" if several else start
         lot.hash = child_hash(root_hash(self.seed), name_hash(start), index)
         stack = [(lot, grammar, grammar.rules[start], {}, (0, 1, 0, 1, 0.0, 0.0))]
+        reuse, table = self.reuse, self.table
         gc_was_on = gc.isenabled()
         # hundreds of thousands of short-lived shapes and no cycles: measured 15% faster
         gc.disable()
         try:
             while stack:
                 item = stack.pop()
-                if item[0] is EMIT:
+                first = item[0]
+                if first is EMIT:
                     self.emit(*item[1:])
                     continue
+                if first is RECORDED:  # a reusable subtree is done: keep what it emitted
+                    reuse.record(self, *item[1:])
+                    continue
                 shape, module, rule_node, args, indices = item
+                key = reuse.key(shape, module, rule_node, args)
+                if key is not None:
+                    found = reuse.records.get(key)
+                    if found is not None and reuse.replay(
+                        self, key, found, shape, module, rule_node.pos
+                    ):
+                        continue
+                    marks = (
+                        self.shapes,
+                        self.barren_shapes,
+                        self.triangles,
+                        len(table.tex_rows),
+                        len(self.warnings),
+                    )
+                    # derived at the world's origin and moved when done (reuse.py), so that
+                    # a replay and a derivation make the same numbers
+                    where = (tuple(shape.origin), shape.path)
+                    shape.origin = [0.0, 0.0, 0.0]
+                    stack.append((RECORDED, key, where, len(table.label), marks))
                 app = Application(self, shape, module, rule_node, args, indices)
                 app.run()
                 stack.extend(reversed(app.children))

@@ -1,0 +1,283 @@
+"""Derive each repeated subtree once (issue 30): a façade repeats the same floor, a floor the
+same tile, thousands of times, and a rule whose subtree draws no randomness and reads nothing
+of where its shape is gives the same terminals, moved, every time.
+
+:func:`reusable` is the static analysis: a rule may be reused when nothing it can reach (its
+body, the rules it hands shapes to, the functions and defaults it evaluates) draws randomness
+(``rand``, ``randint``, a stochastic body), reads its shape's place or context (``scope.x``,
+``split.index``, ``comp.*``, ``depth``, ``seed``), texture-projects, or hands a shape to a rule
+held in a parameter.  :class:`Reuse` keeps, per (rule, arguments, the shape's size, axes,
+geometry, colour, material, label and depth), what the first such subtree emitted, relative to
+its shape's origin; the engine replays it for every later shape with the same key.  The axes
+are part of the key, so a replay only moves rows: their axes, sizes, meshes, colours and
+labels are the recorded ones, and their origins are the recorded offsets plus the new origin.
+Paths are the new shape's path plus the recorded suffixes, so the terminal list is the one a
+full derivation gives, row for row, in the same order.
+"""
+
+from __future__ import annotations
+
+from collections import OrderedDict
+from dataclasses import dataclass
+
+from bgr.grammar import nodes as n
+from bgr.grammar.registry import OPERATIONS
+
+from .geometry.polygons import RECT
+from .limits import MEMORY_CHECK_EVERY
+
+# names whose value depends on where the shape is, or on its place among its siblings
+PLACED = {
+    "scope.x",
+    "scope.y",
+    "scope.z",
+    "split.index",
+    "split.total",
+    "comp.index",
+    "comp.total",
+    "comp.left",
+    "comp.right",
+    "depth",
+    "seed",
+}
+RANDOM = {"rand", "randint"}
+# a subtree of up to this many terminals is kept the first time it is derived (a tile, a floor);
+# a larger one the second time (grid_city at n = 20: 1.34 s and 374 MB keeping all the first
+# time, 1.65 s and 281 MB keeping all the second time)
+FIRST_MOST = 256
+# rows all records hold together, at most: the least recently replayed are forgotten first, so
+# memory stays flat however large the city (a façade's floors are replayed right after they
+# are recorded, and then never again)
+KEEP_MOST = 50_000
+TEXTURING = {name for name, op in OPERATIONS.items() if op.family == "texturing"}
+
+
+def reusable(module, name: str, known: dict) -> bool:
+    """Whether rule ``name`` of ``module`` may be derived once and replayed (see the module
+    docstring); ``known`` caches the answers, by (id(module), name)."""
+    key = (id(module), name)
+    if key in known:
+        return known[key]
+    known[key] = True  # a rule that reaches itself: decided by the rest of its body
+    rule = module.rules.get(name)
+    ok = rule is not None and _body_ok(module, rule, known)
+    known[key] = ok
+    return ok
+
+
+def _body_ok(module, rule: n.Rule, known: dict) -> bool:
+    local = set(rule.params)
+    if not all(_expr_ok(module, d, known) for d in rule.defaults if d is not None):
+        return False
+    body = rule.body
+    if isinstance(body, n.Stochastic):
+        return False
+    if isinstance(body, n.Conditional):
+        return all(
+            (case.cond is None or _expr_ok(module, case.cond, known))
+            and _steps_ok(module, case.body.steps, local, known)
+            for case in body.cases
+        )
+    return _steps_ok(module, body.steps, local, known)
+
+
+def _steps_ok(module, steps, local: set, known: dict) -> bool:
+    for step in steps:
+        if isinstance(step, n.Push):
+            if not _steps_ok(module, step.steps, local, known):
+                return False
+        elif isinstance(step, n.Successor):
+            if step.name in local:  # a rule held in a parameter: known only when it runs
+                return False
+            if not all(_expr_ok(module, _value(a), known) for a in step.args):
+                return False
+            target, member = module.lookup_module(step.name)
+            if member in target.rules and not reusable(target, member, known):
+                return False
+        elif isinstance(step, n.Operation):
+            if step.name in TEXTURING:
+                return False
+            if not all(_expr_ok(module, _value(a), known) for a in step.args):
+                return False
+            if step.block is not None and not _block_ok(module, step.block.entries, local, known):
+                return False
+    return True
+
+
+def _block_ok(module, entries, local: set, known: dict) -> bool:
+    for entry in entries:
+        if isinstance(entry, n.Group):
+            if not _block_ok(module, entry.entries, local, known):
+                return False
+        elif not (
+            _expr_ok(module, entry.key, known) and _steps_ok(module, entry.body.steps, local, known)
+        ):
+            return False
+    return True
+
+
+def _value(arg):
+    return (
+        arg.value
+        if isinstance(arg, n.Keyword)
+        else arg.expr
+        if isinstance(arg, n.Relative)
+        else arg
+    )
+
+
+def _expr_ok(module, node, known: dict, seen: frozenset = frozenset()) -> bool:
+    if isinstance(node, n.Name):
+        return node.name not in PLACED
+    if isinstance(node, n.Call):
+        if node.name in RANDOM:
+            return False
+        if not all(_expr_ok(module, a, known, seen) for a in node.args):
+            return False
+        target, member = module.lookup_module(node.name)
+        func = target.funcs.get(member) if hasattr(target, "funcs") else None
+        if func is not None and (id(target), member) not in seen:
+            return _expr_ok(target, func.body, known, seen | {(id(target), member)})
+        return True
+    if isinstance(node, n.Unary):
+        return _expr_ok(module, node.operand, known, seen)
+    if isinstance(node, n.Binary):
+        return _expr_ok(module, node.left, known, seen) and _expr_ok(
+            module, node.right, known, seen
+        )
+    if isinstance(node, n.Ternary):
+        return all(_expr_ok(module, e, known, seen) for e in (node.cond, node.then, node.otherwise))
+    return True  # a number, a string, a boolean
+
+
+@dataclass
+class Record:
+    """What one subtree emitted, relative to its shape's origin."""
+
+    offsets: list  # per row: origin minus the shape's origin
+    axes: list
+    sizes: list
+    colors: list
+    materials: list
+    meshes: list
+    labels: list
+    rules: list
+    suffixes: list  # per row: its path after the shape's
+    shapes: int  # shapes the subtree made
+    barren: int
+    triangles: int
+
+
+class Reuse:
+    """The records of one derivation, by key (see the module docstring).
+
+    A reusable rule's subtree is always derived with its shape moved to the world's origin and
+    its rows moved back when it is done, whether or not it is replayed, so that a replayed row
+    (recorded offset plus origin) and a derived one are the same float64 numbers: with
+    ``replay`` off (BGR_REUSE=0) every output is the same, byte for byte.  A small subtree is
+    kept the first time it is derived; a large one (a whole façade, which rarely repeats) the
+    second time.
+    """
+
+    def __init__(self, replay: bool = True) -> None:
+        self.replaying = replay
+        self.known: dict = {}  # (id(module), rule name) -> reusable?
+        self.seen: set = set()
+        self.records: OrderedDict = OrderedDict()  # least recently replayed first
+        self.rows = 0  # rows the records hold, at most KEEP_MOST
+        self.hits = 0
+
+    def key(self, shape, module, rule: n.Rule, args: dict):
+        """The key of a rule applied to a shape, or None when its subtree is not reusable."""
+        if shape.tex is not None or not reusable(module, rule.name, self.known):
+            return None
+        geom = shape.geom
+        polys = getattr(geom, "polys", None)
+        if polys is not None and polys != RECT:
+            geom = (type(geom).__name__, geom.k, geom.name, tuple(polys))
+        try:
+            key = (
+                id(module),
+                id(rule),
+                tuple(sorted(args.items())) if args else (),
+                tuple(shape.size),
+                shape.axes,
+                geom,
+                shape.color,
+                shape.material,
+                shape.label,
+                shape.depth,
+            )
+            hash(key)
+        except TypeError:  # an argument or a geometry that cannot be a key
+            return None
+        return key
+
+    def record(self, engine, key, where: tuple, start: int, marks: tuple) -> None:
+        """Move the rows a subtree emitted (``start`` on, derived at the world's origin) to
+        ``where``, its shape's (origin, path) when the rule was applied; keep them for replays
+        the second time the key is seen, unless the subtree made textured rows or warnings,
+        which are not replayed."""
+        t = engine.table
+        (ox, oy, oz), path = where
+        local = t.origin[start:]
+        t.origin[start:] = [[x + ox, y + oy, z + oz] for x, y, z in local]
+        if not self.replaying:
+            return
+        if key not in self.seen and len(local) > FIRST_MOST:
+            self.seen.add(key)  # a large subtree is kept once it repeats (a façade rarely does)
+            return
+        shapes, barren, triangles, textured, warned = marks
+        if len(t.tex_rows) != textured or len(engine.warnings) != warned:
+            return
+        prefix = len(path)
+        self.rows += len(local)
+        while self.rows > KEEP_MOST and self.records:  # forget the least recently replayed
+            self.rows -= len(self.records.popitem(last=False)[1].offsets)
+        self.records[key] = Record(
+            local,
+            t.axes[start:],
+            t.size[start:],
+            t.color[start:],
+            t.material[start:],
+            t.mesh[start:],
+            t.label[start:],
+            t.rule[start:],
+            [p[prefix:] for p in t.path[start:]],
+            engine.shapes - shapes,
+            engine.barren_shapes - barren,
+            engine.triangles - triangles,
+        )
+
+    def replay(self, engine, key, record: Record, shape, module, pos) -> bool:
+        """Emit a record's rows for ``shape``; False (nothing done) when that would pass a
+        budget, so that the full derivation reports it where it happens.  ``module`` and
+        ``pos`` (the rule's) locate a memory-ceiling error."""
+        if (
+            engine.shapes + record.shapes > engine.max_shapes
+            or engine.triangles + record.triangles > engine.max_triangles
+        ):
+            return False
+        t = engine.table
+        ox, oy, oz = shape.origin
+        t.origin.extend([[x + ox, y + oy, z + oz] for x, y, z in record.offsets])
+        t.axes.extend(record.axes)
+        t.size.extend(record.sizes)
+        t.color.extend(record.colors)
+        t.material.extend(record.materials)
+        t.mesh.extend(record.meshes)
+        t.label.extend(record.labels)
+        t.rule.extend(record.rules)
+        path = shape.path
+        t.path.extend([path + s for s in record.suffixes])
+        before = engine.shapes
+        engine.shapes += record.shapes
+        engine.barren_shapes += record.barren
+        engine.triangles += record.triangles
+        self.hits += 1
+        self.records.move_to_end(key)
+        if engine.max_memory is not None and (
+            engine.shapes // MEMORY_CHECK_EVERY != before // MEMORY_CHECK_EVERY
+        ):
+            engine.check_memory(module, pos)
+        return True
