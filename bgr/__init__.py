@@ -12,20 +12,61 @@ Every bad value, in a file or an argument, is a :class:`BgrError` with a located
 ``load(None)`` or ``format_source(5)``, is a ``TypeError``: a programmer's error, not a user's.
 """
 
-from importlib.metadata import PackageNotFoundError
-from importlib.metadata import version as _version
+from __future__ import annotations
 
-from .grammar.checker import Grammar
-from .grammar.errors import BgrCheckError, BgrError, BgrSyntaxError, Diagnostic
-from .grammar.formatter import format_module, format_source
-from .grammar.loader import load
-from .grammar.parser import parse
-from .interpreter.derive import Result, derive
+from importlib import import_module
+from typing import TYPE_CHECKING, Any
 
-try:
-    __version__ = _version("bgr")
-except PackageNotFoundError:  # pragma: no cover - running from a source tree without install
-    __version__ = "0+unknown"
+if TYPE_CHECKING:
+    from .grammar.checker import Grammar
+    from .grammar.errors import BgrCheckError, BgrError, BgrSyntaxError, Diagnostic
+    from .grammar.formatter import format_module, format_source
+    from .grammar.loader import load
+    from .grammar.parser import parse
+    from .interpreter.derive import Result, derive
+
+# The API is imported when first used, not with the package: ``bgr --version`` and a command
+# that needs only the parser start without the interpreter, numpy and trimesh (issue 30).
+_WHERE = {
+    "Grammar": ".grammar.checker",
+    "BgrError": ".grammar.errors",
+    "BgrCheckError": ".grammar.errors",
+    "BgrSyntaxError": ".grammar.errors",
+    "Diagnostic": ".grammar.errors",
+    "format_module": ".grammar.formatter",
+    "format_source": ".grammar.formatter",
+    "load": ".grammar.loader",
+    "parse": ".grammar.parser",
+    "Result": ".interpreter.derive",
+    "derive": ".interpreter.derive",
+}
+# the package's folders, as attributes: ``import bgr; bgr.formats.meshes``
+_PACKAGES = {"formats", "grammar", "interpreter", "inverse", "render", "stdlib"}
+
+
+def version() -> str:
+    """The installed package's version ("0+unknown" in a source tree without install)."""
+    from importlib.metadata import PackageNotFoundError
+    from importlib.metadata import version as installed
+
+    try:
+        return installed("bgr")
+    except PackageNotFoundError:  # pragma: no cover - running from a source tree without install
+        return "0+unknown"
+
+
+def __getattr__(name: str) -> Any:
+    if name in _WHERE:
+        value = getattr(import_module(_WHERE[name], __name__), name)
+    elif name in _PACKAGES:
+        value = import_module(f".{name}", __name__)
+    elif name == "__version__":
+        value = version()
+    else:
+        raise AttributeError(f"module 'bgr' has no attribute {name!r}")
+    globals()[name] = value
+    return value
+
 
 __all__ = [
     "load",

@@ -116,6 +116,26 @@ def _block_ok(module, entries, local: set, known: dict) -> bool:
     return True
 
 
+def _spawns(rule: n.Rule) -> bool:
+    """Whether a rule hands shapes on (a successor, a split, a component split): a rule that
+    only paints or inserts makes one terminal, as quick to derive as to replay."""
+    bodies = (
+        [rule.body.steps]
+        if isinstance(rule.body, n.Sequence)
+        else [c.body.steps for c in getattr(rule.body, "cases", getattr(rule.body, "choices", []))]
+    )
+    return any(_spawning(steps) for steps in bodies)
+
+
+def _spawning(steps) -> bool:
+    for step in steps:
+        if isinstance(step, n.Successor) or (isinstance(step, n.Operation) and step.block):
+            return True
+        if isinstance(step, n.Push) and _spawning(step.steps):
+            return True
+    return False
+
+
 def _value(arg):
     return (
         arg.value
@@ -182,14 +202,19 @@ class Reuse:
     def __init__(self, replay: bool = True) -> None:
         self.replaying = replay
         self.known: dict = {}  # (id(module), rule name) -> reusable?
+        self.worth: dict = {}  # id(rule) -> reusable and making more than one shape?
         self.seen: set = set()
         self.records: OrderedDict = OrderedDict()  # least recently replayed first
         self.rows = 0  # rows the records hold, at most KEEP_MOST
         self.hits = 0
 
     def key(self, shape, module, rule: n.Rule, args: dict):
-        """The key of a rule applied to a shape, or None when its subtree is not reusable."""
-        if shape.tex is not None or not reusable(module, rule.name, self.known):
+        """The key of a rule applied to a shape, or None when its subtree is not reusable (or
+        is one terminal, which costs no more to derive than to replay)."""
+        worth = self.worth.get(id(rule))
+        if worth is None:
+            worth = self.worth[id(rule)] = _spawns(rule) and reusable(module, rule.name, self.known)
+        if not worth or shape.tex is not None:
             return None
         geom = shape.geom
         polys = getattr(geom, "polys", None)

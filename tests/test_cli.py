@@ -124,3 +124,19 @@ def test_infer_names_what_a_file_is_not_and_what_it_reads(tmp_path, name, data, 
         (tmp_path / "x.json").write_bytes(data)
         out = run("infer", str(tmp_path / "x.json"))
         assert out.returncode == 1 and f"error: {what}" in out.stderr
+
+
+def test_version_answers_without_importing_the_toolkit():
+    """``bgr --version`` starts in a few hundredths of a second: it imports neither the
+    parser nor numpy (issue 30; it took 0.6 s when the package imported everything)."""
+    import subprocess
+    import sys
+
+    code = (
+        "import sys; from bgr.entry import main; main(['--version']); "
+        "print(sorted(m for m in ('numpy', 'lark', 'trimesh', 'bgr.cli') if m in sys.modules))"
+    )
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    version_line, imported = out.stdout.splitlines()
+    assert version_line.startswith("bgr ")
+    assert imported == "[]"
