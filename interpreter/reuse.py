@@ -5,12 +5,13 @@ of where its shape is gives the same terminals, moved, every time.
 :func:`reusable` is the static analysis: a rule may be reused when nothing it can reach (its
 body, the rules it hands shapes to, the functions and defaults it evaluates) draws randomness
 (``rand``, ``randint``, a stochastic body), reads its shape's place or context (``scope.x``,
-``split.index``, ``comp.*``, ``depth``, ``seed``), texture-projects, or hands a shape to a rule
-held in a parameter.  :class:`Reuse` keeps, per (rule, arguments, the shape's size, axes,
-geometry, colour, material, label and depth), what the first such subtree emitted, relative to
-its shape's origin; the engine replays it for every later shape with the same key.  The axes
-are part of the key, so a replay only moves rows: their axes, sizes, meshes, colours and
-labels are the recorded ones, and their origins are the recorded offsets plus the new origin.
+``split.index``, ``comp.*``, ``depth``, ``seed``) or texture-projects; a rule held in a
+parameter is checked when the rule is applied, with its arguments.  :class:`Reuse` keeps, per
+(rule, arguments, the shape's size, axes, geometry, colour, material, label and depth), what
+the first such subtree emitted, relative to its shape's origin; the engine replays it for
+every later shape with the same key.  The axes are part of the key, so a replay only moves
+rows: their axes, sizes, meshes, colours and labels are the recorded ones, and their origins
+are the recorded offsets plus the new origin.
 Paths are the new shape's path plus the recorded suffixes, so the terminal list is the one a
 full derivation gives, row for row, in the same order.
 """
@@ -23,6 +24,7 @@ from dataclasses import dataclass
 from bgr.grammar import nodes as n
 from bgr.grammar.registry import OPERATIONS
 
+from .expressions import RuleRef
 from .geometry.polygons import RECT
 from .limits import MEMORY_CHECK_EVERY
 
@@ -67,14 +69,14 @@ def reusable(module, name: str, known: dict) -> bool:
 
 def _body_ok(module, rule: n.Rule, known: dict) -> bool:
     local = set(rule.params)
-    if not all(_expr_ok(module, d, known) for d in rule.defaults if d is not None):
+    if not all(_expr_ok(module, d, known, local) for d in rule.defaults if d is not None):
         return False
     body = rule.body
     if isinstance(body, n.Stochastic):
         return False
     if isinstance(body, n.Conditional):
         return all(
-            (case.cond is None or _expr_ok(module, case.cond, known))
+            (case.cond is None or _expr_ok(module, case.cond, known, local))
             and _steps_ok(module, case.body.steps, local, known)
             for case in body.cases
         )
@@ -87,17 +89,17 @@ def _steps_ok(module, steps, local: set, known: dict) -> bool:
             if not _steps_ok(module, step.steps, local, known):
                 return False
         elif isinstance(step, n.Successor):
-            if step.name in local:  # a rule held in a parameter: known only when it runs
+            if not all(_expr_ok(module, _value(a), known, local) for a in step.args):
                 return False
-            if not all(_expr_ok(module, _value(a), known) for a in step.args):
-                return False
+            if step.name in local:  # a rule held in a parameter: checked with the arguments
+                continue
             target, member = module.lookup_module(step.name)
             if member in target.rules and not reusable(target, member, known):
                 return False
         elif isinstance(step, n.Operation):
             if step.name in TEXTURING:
                 return False
-            if not all(_expr_ok(module, _value(a), known) for a in step.args):
+            if not all(_expr_ok(module, _value(a), known, local) for a in step.args):
                 return False
             if step.block is not None and not _block_ok(module, step.block.entries, local, known):
                 return False
@@ -110,7 +112,8 @@ def _block_ok(module, entries, local: set, known: dict) -> bool:
             if not _block_ok(module, entry.entries, local, known):
                 return False
         elif not (
-            _expr_ok(module, entry.key, known) and _steps_ok(module, entry.body.steps, local, known)
+            _expr_ok(module, entry.key, known, local)
+            and _steps_ok(module, entry.body.steps, local, known)
         ):
             return False
     return True
@@ -146,27 +149,40 @@ def _value(arg):
     )
 
 
-def _expr_ok(module, node, known: dict, seen: frozenset = frozenset()) -> bool:
+def _expr_ok(
+    module, node, known: dict, local: set | frozenset = frozenset(), seen: frozenset = frozenset()
+) -> bool:
+    """Whether an expression draws no randomness and reads nothing of its shape's place; a
+    name in ``local`` is a parameter (its value is part of the key), even if it is called
+    ``depth``."""
     if isinstance(node, n.Name):
-        return node.name not in PLACED
+        if node.name in local:
+            return True
+        if node.name in PLACED:
+            return False
+        target, member = module.lookup_module(node.name)  # a rule handed on as a value
+        return member not in target.rules or reusable(target, member, known)
     if isinstance(node, n.Call):
         if node.name in RANDOM:
             return False
-        if not all(_expr_ok(module, a, known, seen) for a in node.args):
+        if not all(_expr_ok(module, a, known, local, seen) for a in node.args):
             return False
         target, member = module.lookup_module(node.name)
         func = target.funcs.get(member) if hasattr(target, "funcs") else None
         if func is not None and (id(target), member) not in seen:
-            return _expr_ok(target, func.body, known, seen | {(id(target), member)})
+            inner = frozenset(func.params)  # a function sees its parameters, not the rule's
+            return _expr_ok(target, func.body, known, inner, seen | {(id(target), member)})
         return True
     if isinstance(node, n.Unary):
-        return _expr_ok(module, node.operand, known, seen)
+        return _expr_ok(module, node.operand, known, local, seen)
     if isinstance(node, n.Binary):
-        return _expr_ok(module, node.left, known, seen) and _expr_ok(
-            module, node.right, known, seen
+        return _expr_ok(module, node.left, known, local, seen) and _expr_ok(
+            module, node.right, known, local, seen
         )
     if isinstance(node, n.Ternary):
-        return all(_expr_ok(module, e, known, seen) for e in (node.cond, node.then, node.otherwise))
+        return all(
+            _expr_ok(module, e, known, local, seen) for e in (node.cond, node.then, node.otherwise)
+        )
     return True  # a number, a string, a boolean
 
 
@@ -220,6 +236,13 @@ class Reuse:
         polys = getattr(geom, "polys", None)
         if polys is not None and polys != RECT:
             geom = (type(geom).__name__, geom.k, geom.name, tuple(polys))
+        for value in args.values():  # a rule handed over: its own subtree must be reusable
+            if (
+                isinstance(value, RuleRef)
+                and value.member in value.module.rules
+                and not reusable(value.module, value.member, self.known)
+            ):
+                return None
         try:
             key = (
                 id(module),

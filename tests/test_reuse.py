@@ -133,8 +133,13 @@ Floor --> split(x) { ~2: Tile }*
             "Tile2 --> color(0, 1, 0)",
             "size",
         ),
+        (
+            "Tile --> Bay(part = Pane)\nBay(part) --> split(x) { ~1: part | ~1: part }\n"
+            "Pane --> color(rand(0, 1), 0, 0)",
+            "color",
+        ),
     ],
-    ids=["rand", "scope.x", "split.index"],
+    ids=["rand", "scope.x", "split.index", "random rule held in a parameter"],
 )
 def test_what_draws_randomness_or_reads_its_place_is_derived_each_time(
     monkeypatch, tmp_path, tile, varies
