@@ -44,7 +44,15 @@ class PrismFit:
 
 
 def fit_prism(comp: Component, tolerance: float) -> PrismFit | None:
-    """The prism a component is within ``tolerance`` (metres), or None when it is none."""
+    """The prism a component is within ``tolerance`` (metres), or None when it is none (or
+    when GEOS or the triangulator cannot make sense of its outline: it keeps its mesh)."""
+    try:
+        return _fit(comp, tolerance)
+    except (shapely.errors.GEOSException, ValueError, IndexError):
+        return None
+
+
+def _fit(comp: Component, tolerance: float) -> PrismFit | None:
     v, f = comp.vertices, comp.faces
     height = float(comp.size[1])
     if len(f) == 0 or height < MIN_HEIGHT:
