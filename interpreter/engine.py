@@ -149,6 +149,7 @@ class Engine:
         # id(successor) -> (module, member, member's name hash, its rule or None if a terminal)
         self.targets: dict[int, tuple] = {}
         self.rule_locals: dict[int, frozenset] = {}  # id(rule) -> its parameter names
+        self.defaults: dict[int, tuple] = {}  # id(rule) -> Application.fill_defaults' plan
         # (id(successor), id(target module), target rule) -> Application.binder's plan
         self.binders: dict[tuple, tuple] = {}
 
@@ -270,7 +271,14 @@ class Engine:
         for compiler in self.compilers.values():
             compiler.funcs.clear()
         self.compilers.clear()
-        for cache in (self._exprs, self.signatures, self.binders, self.targets, self._bindings):
+        for cache in (
+            self._exprs,
+            self.signatures,
+            self.binders,
+            self.targets,
+            self._bindings,
+            self.defaults,
+        ):
             cache.clear()
 
     def binding_problem(self, ref: RuleRef, step: n.Successor):
@@ -436,13 +444,18 @@ class Application:
     def fill_defaults(self, args: dict) -> None:
         """Parameters the caller left out take their defaults, evaluated in order in the rule's
         own module on the shape it received (a default may use the parameters before it)."""
-        rule = self.rule
-        for i, p in enumerate(rule.params):
+        rule, engine = self.rule, self.engine
+        plan = engine.defaults.get(id(rule))
+        if plan is None:  # (parameter, compiled default) of each parameter that has one, once
+            plan = engine.defaults[id(rule)] = tuple(
+                (p, engine.compiled(self.compiler, rule.default(i), frozenset(rule.params[:i])))
+                for i, p in enumerate(rule.params)
+                if rule.default(i) is not None
+            )
+        ctx = self.ctx
+        for p, fn in plan:
             if p not in args:
-                fn = self.engine.compiled(
-                    self.compiler, rule.default(i), frozenset(rule.params[:i])
-                )
-                args[p] = fn(self.ctx)
+                args[p] = fn(ctx)
 
     def value(self, node):
         return self.engine.compiled(self.compiler, node, self.local)(self.ctx)

@@ -269,7 +269,8 @@ class Reuse:
         t = engine.table
         (ox, oy, oz), path = where
         local = t.origin[start:]
-        t.origin[start:] = [[x + ox, y + oy, z + oz] for x, y, z in local]
+        if ox or oy or oz:  # a piece at its parent's corner (the first of a split) stays put
+            t.origin[start:] = [(x + ox, y + oy, z + oz) for x, y, z in local]
         if not self.replaying:
             return
         if key not in self.seen and len(local) > FIRST_MOST:
@@ -308,7 +309,10 @@ class Reuse:
             return False
         t = engine.table
         ox, oy, oz = shape.origin
-        t.origin.extend([[x + ox, y + oy, z + oz] for x, y, z in record.offsets])
+        if ox or oy or oz:  # as record() moves them: not at all to the origin itself
+            t.origin.extend([(x + ox, y + oy, z + oz) for x, y, z in record.offsets])
+        else:
+            t.origin.extend(record.offsets)
         t.axes.extend(record.axes)
         t.size.extend(record.sizes)
         t.color.extend(record.colors)
