@@ -56,7 +56,21 @@ TEXTURING = {name for name, op in OPERATIONS.items() if op.family == "texturing"
 
 def reusable(module, name: str, known: dict) -> bool:
     """Whether rule ``name`` of ``module`` may be derived once and replayed (see the module
-    docstring); ``known`` caches the answers, by (id(module), name)."""
+    docstring); ``known`` caches the answers, by (id(module), name).  A chain of rules deeper
+    than Python's recursion allows is answered no, for every rule the search had reached."""
+    key = (id(module), name)
+    if key in known:
+        return known[key]
+    before = set(known)
+    try:
+        return _reusable(module, name, known)
+    except RecursionError:
+        for reached in set(known) - before:
+            known[reached] = False
+        return False
+
+
+def _reusable(module, name: str, known: dict) -> bool:
     key = (id(module), name)
     if key in known:
         return known[key]
@@ -94,7 +108,7 @@ def _steps_ok(module, steps, local: set, known: dict) -> bool:
             if step.name in local:  # a rule held in a parameter: checked with the arguments
                 continue
             target, member = module.lookup_module(step.name)
-            if member in target.rules and not reusable(target, member, known):
+            if member in target.rules and not _reusable(target, member, known):
                 return False
         elif isinstance(step, n.Operation):
             if step.name in TEXTURING:
@@ -161,7 +175,7 @@ def _expr_ok(
         if node.name in PLACED:
             return False
         target, member = module.lookup_module(node.name)  # a rule handed on as a value
-        return member not in target.rules or reusable(target, member, known)
+        return member not in target.rules or _reusable(target, member, known)
     if isinstance(node, n.Call):
         if node.name in RANDOM:
             return False

@@ -211,7 +211,7 @@ def test_100000_one_triangle_objects_infer_in_30_s(tmp_path):
     types = int(re.search(r"100000 objects, 100000 components, (\d) types", done.stderr)[1])
     meshes = trimesh.load(tmp_path / "city.assets" / "meshes.glb", force="scene")
     assert len(meshes.graph.nodes_geometry) == types
-    assert "\nCity -->\n    [ matrix(" in (tmp_path / "city.bgr").read_text()
+    assert "\nCity -->\n    [ t(" in (tmp_path / "city.bgr").read_text()
     assert took < 30.0, f"{took:.1f} s"
 
 
