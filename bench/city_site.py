@@ -40,12 +40,27 @@ def bgr(*args: str) -> None:
         raise SystemExit(f"bgr {' '.join(args)}: exit {run.returncode}\n{run.stderr}")
 
 
-def read_input(path: Path) -> trimesh.Trimesh:
+def lods_of(path: Path) -> list[str | None]:
+    """The levels of detail of a CityJSON file whose objects have several (each measured on its
+    own, ``bgr infer --lod``), else [None]: the file as bgr reads it by default."""
+    if path.suffix != ".json":
+        return [None]
+    doc = json.loads(path.read_text())
+    found = {
+        str(g["lod"])
+        for obj in doc.get("CityObjects", {}).values()
+        for g in obj.get("geometry", [])
+        if "lod" in g
+    }
+    return sorted(found) if len(found) > 1 else [None]
+
+
+def read_input(path: Path, lod: str | None = None) -> trimesh.Trimesh:
     if path.suffix == ".obj":
         return trimesh.load(path, force="mesh", process=False)
     from bgr.inverse.city.read import read_city
 
-    scene = read_city(str(path))
+    scene = read_city(str(path), lod=lod)
     parts = [(scene.to_input(o.vertices), o.faces) for o in scene.objects]
     return trimesh.util.concatenate([trimesh.Trimesh(v, f, process=False) for v, f in parts])
 
@@ -79,13 +94,13 @@ def one_way(to: trimesh.Trimesh, source: trimesh.Trimesh) -> float:
     return float(distances(to, source).max())
 
 
-def obj_bytes(path: Path, truth: trimesh.Trimesh) -> int:
+def obj_bytes(path: Path, truth: trimesh.Trimesh, lod: str | None = None) -> int:
     """The size of the city as OBJ: its own OBJ file where ../shared/data has one, else its
-    triangles written as OBJ to the millimetre (as the shipped OBJ files are)."""
+    triangles (at ``lod``) written as OBJ to the millimetre (as the shipped OBJ files are)."""
     if path.suffix == ".obj":
         return path.stat().st_size
     beside = path.with_name(path.name.replace(".city.json", ".obj"))
-    if beside.is_file():
+    if beside.is_file() and lod is None:
         return beside.stat().st_size
     lines = [f"v {x:.3f} {y:.3f} {z:.3f}" for x, y, z in truth.vertices]
     lines += [f"f {a + 1} {b + 1} {c + 1}" for a, b, c in truth.faces]
@@ -116,14 +131,24 @@ def folder_bytes(folder: Path) -> int:
     return sum(p.stat().st_size for p in folder.iterdir()) if folder.is_dir() else 0
 
 
-def levels(path: Path, truth: trimesh.Trimesh, obj: int) -> list[str]:
+def levels(path: Path, truth: trimesh.Trimesh, obj: int, lod: str | None, name: str) -> list[str]:
     """Each level above 0: grammar + assets against the OBJ, and the Chamfer distance (mean of
     the two one-way mean distances) of its derived OBJ to the input, measured by trimesh."""
     rows, level, last = [], 1, 1
     while level <= last:
         with tempfile.TemporaryDirectory() as tmp:
             grammar = Path(tmp) / "city.bgr"
-            bgr("infer", str(path), "--no-progress", "--level", str(level), "-o", str(grammar))
+            pick = ["--lod", lod] if lod else []
+            bgr(
+                "infer",
+                str(path),
+                *pick,
+                "--no-progress",
+                "--level",
+                str(level),
+                "-o",
+                str(grammar),
+            )
             # the header says "(level L of M)": a level past M is M again
             found = re.search(r"\(level \d+ of (\d+)\)", grammar.read_text())
             last = int(found.group(1)) if found else level
@@ -132,7 +157,7 @@ def levels(path: Path, truth: trimesh.Trimesh, obj: int) -> list[str]:
             bgr("derive", str(grammar), "-o", str(out))
             mesh = read_output(out)
             chamfer = (distances(truth, mesh).mean() + distances(mesh, truth).mean()) / 2
-            rows.append(f"| {path.name} | {level} | {size:,} | {obj / size:.1f} | {chamfer:.3f} |")
+            rows.append(f"| {name} | {level} | {size:,} | {obj / size:.1f} | {chamfer:.3f} |")
         level += 1
     return rows
 
@@ -143,17 +168,19 @@ def main() -> None:
         p for p in CITIES.iterdir() if p.suffix in (".obj", ".json")
     )
     rows, sizes, coarse = [], [], []
-    for path in files:
-        truth = read_input(path)
-        obj = obj_bytes(path, truth)
+    for path, lod in [(p, lod) for p in files for lod in lods_of(p)]:
+        name = path.name if lod is None else f"{path.name} (LoD {lod})"
+        pick = ["--lod", lod] if lod else []
+        truth = read_input(path, lod)
+        obj = obj_bytes(path, truth, lod)
         with tempfile.TemporaryDirectory() as tmp:
             grammar = Path(tmp) / "city.bgr"
-            bgr("infer", str(path), "--no-progress", "-o", str(grammar))
+            bgr("infer", str(path), *pick, "--no-progress", "-o", str(grammar))
             assets = folder_bytes(Path(tmp) / "city.assets")
             text = grammar.stat().st_size
             size = path.stat().st_size
             sizes.append(
-                f"| {path.name} | {size:,} | {obj:,} | {text:,} | {assets:,} | "
+                f"| {name} | {size:,} | {obj:,} | {text:,} | {assets:,} | "
                 f"{(text + assets) / obj:.2f} |"
             )
             site = next(
@@ -166,10 +193,10 @@ def main() -> None:
                 mesh = read_output(out)
                 distance = max(one_way(truth, mesh), one_way(mesh, truth))
                 offset = float(np.abs(mesh.bounds[0] - truth.bounds[0]).max())
-                rows.append(f"| {path.name} | `{site}` | .{ext} | {distance:.4f} | {offset:.4f} |")
+                rows.append(f"| {name} | `{site}` | .{ext} | {distance:.4f} | {offset:.4f} |")
         with tempfile.TemporaryDirectory() as tmp:
             alone = Path(tmp) / "buildings.obj"
-            if buildings_obj(path, alone):
+            if lod is None and buildings_obj(path, alone):
                 grammar = Path(tmp) / "city.bgr"
                 bgr("infer", str(alone), "--no-progress", "-o", str(grammar))
                 text, assets = grammar.stat().st_size, folder_bytes(Path(tmp) / "city.assets")
@@ -179,7 +206,7 @@ def main() -> None:
                     f"{(text + assets) / obj:.2f} |"
                 )
         if "--levels" in flags:
-            coarse += levels(path, truth, obj_bytes(path, truth))
+            coarse += levels(path, truth, obj, lod, name)
     head = "| input | input bytes | OBJ bytes | grammar bytes | assets bytes |"
     print(head + " (grammar + assets) / OBJ |")
     print("|---|---|---|---|---|---|")

@@ -345,6 +345,12 @@ def build_parser() -> argparse.ArgumentParser:
         "distance to the nearest building)",
     )
     city.add_argument(
+        "--lod",
+        metavar="LOD",
+        help="CityJSON only: the level of detail to read, as the file writes it (e.g. 1.2, "
+        "2.2; default: each object's highest)",
+    )
+    city.add_argument(
         "--tolerance",
         type=float,
         default=0.01,
@@ -357,6 +363,12 @@ def build_parser() -> argparse.ArgumentParser:
         choices=["mean", "fewest"],
         default="mean",
         help="a type's mesh: the member closest to the mean (default) or with fewest triangles",
+    )
+    city.add_argument(
+        "--plain-assets",
+        action="store_true",
+        help="write the assets GLB as plain glTF 2.0 (larger) instead of compressed with "
+        "EXT_meshopt_compression and KHR_mesh_quantization, for readers without them (trimesh)",
     )
     city.add_argument(
         "--stats",

@@ -8,8 +8,9 @@ returns world-space triangles with per-face sRGB colours: what tests and preview
 The files come from anywhere, so nothing in them is believed: every accessor, bufferView, index
 and node is checked (:mod:`.gltf_checks`) before a byte is read or a node placed, and a file that
 breaks a rule is a located :class:`BgrError`.  The buffers are read by :mod:`.gltf_file` (from
-the GLB's BIN chunk, base64 ``data:`` URIs or files in the model's own folder); sparse,
-compressed and quantized data (KHR_mesh_quantization) are refused.
+the GLB's BIN chunk, base64 ``data:`` URIs or files in the model's own folder), views compressed
+by EXT_meshopt_compression decoded first (:mod:`.gltf_meshopt`); integer positions are read
+where the file uses KHR_mesh_quantization; sparse accessors and Draco are refused.
 """
 
 from __future__ import annotations
@@ -49,6 +50,7 @@ __all__ = [
     "instance_count",
     "load",
     "mesh_nodes",
+    "named_meshes",
     "node_matrix",
     "parse",
     "quat_matrix",
@@ -323,7 +325,7 @@ def _primitive(gltf: dict, blob: bytes, prim: dict, where: str) -> tuple[np.ndar
     if not isinstance(attrs, dict) or "POSITION" not in attrs:
         fail(where, "has no POSITION attribute")
     p = attrs["POSITION"]
-    pos = accessor(gltf, blob, p, f"POSITION of {where}", FLOAT, ("VEC3",))
+    pos = _positions(gltf, blob, p, f"POSITION of {where}")
     if "indices" in prim:
         name, what = f"accessor {prim['indices']}", "indices"
         flat = accessor(gltf, blob, prim["indices"], f"indices of {where}", UNSIGNED, ("SCALAR",))
@@ -336,6 +338,24 @@ def _primitive(gltf: dict, blob: bytes, prim: dict, where: str) -> tuple[np.ndar
         k = int(np.argmax(flat >= len(pos)))
         fail(name, f"index {flat[k]} (element {k}) is past the {len(pos)} vertices of accessor {p}")
     return pos, flat.reshape(-1, 3)
+
+
+QUANTIZED = "KHR_mesh_quantization"
+NORMALIZED = {5120: 127.0, 5121: 255.0, 5122: 32767.0, 5123: 65535.0}  # glTF 2.0, 3.11
+
+
+def _positions(gltf: dict, blob: bytes, index: int, use: str) -> np.ndarray:
+    """Float VEC3 positions; with KHR_mesh_quantization (listed in extensionsUsed) also 8- and
+    16-bit integers, normalized ones mapped to [0, 1] or [-1, 1] as glTF states (the node's
+    scale, applied by the caller, turns them into metres)."""
+    used = gltf.get("extensionsUsed")
+    quantized = isinstance(used, list) and QUANTIZED in used
+    kinds = FLOAT + (tuple(NORMALIZED) if quantized else ())
+    pos = accessor(gltf, blob, index, use, kinds, ("VEC3",))
+    ctype = gltf["accessors"][index]["componentType"]
+    if ctype in NORMALIZED and gltf["accessors"][index].get("normalized") is True:
+        pos = np.maximum(pos / NORMALIZED[ctype], -1.0)
+    return pos
 
 
 def _colour(gltf: dict, prim: dict, where: str) -> np.ndarray:
@@ -405,6 +425,34 @@ def world_mesh(
         face_colors=np.concatenate(colours),
         process=False,
     )
+
+
+def named_meshes(gltf: dict, blob: bytes) -> dict[str, tuple[np.ndarray, np.ndarray]]:
+    """(vertices, triangles) of every named node with a mesh, placed in the default scene (its
+    ancestors' transforms and its own applied, instances expanded), by node name: what a grammar's
+    ``asset a = "meshes.glb#name"`` inserts.  Where several nodes share a name, the first in the
+    walk's order; the whole scene is held to the triangle cap first."""
+    roots = scene_roots(gltf)
+    paths = node_paths(gltf, roots)
+    _check_triangles(gltf, blob, paths)
+    out: dict[str, tuple[np.ndarray, np.ndarray]] = {}
+    primitives: dict[str, tuple[np.ndarray, np.ndarray]] = {}
+    for i, node, world in mesh_nodes(gltf, roots, None, paths):
+        name = node.get("name")
+        if not isinstance(name, str) or name in out:
+            continue
+        copies = _instances(gltf, blob, node, i)
+        placements = world[None] if copies is None else world @ copies
+        verts, faces, count = [np.zeros((0, 3))], [np.zeros((0, 3), dtype=np.int64)], 0
+        for where, prim in triangle_primitives(gltf, node, i):
+            if where not in primitives:
+                primitives[where] = _primitive(gltf, blob, prim, where)
+            placed, tris = _placed(*primitives[where], placements, f"node {i}")
+            verts.append(placed)
+            faces.append(tris + count)
+            count += len(placed)
+        out[name] = (np.concatenate(verts), np.concatenate(faces))
+    return out
 
 
 def _placed(

@@ -49,7 +49,7 @@ SINGULAR = {
     "nodes": "node",
     "scenes": "scene",
 }
-STORED = "compressed (Draco, meshopt), sparse or quantized data is not read"
+STORED = "Draco-compressed and sparse data is not read"
 
 
 def fail(where: str, message: str, hint: str | None = None) -> NoReturn:
@@ -225,7 +225,7 @@ def check_kind(gltf: dict, index: int, use: str, components: tuple, types: tuple
         allowed = " or ".join(f"{COMPONENT_NAMES[c]} ({c})" for c in components)
         hint = None
         if use.startswith("POSITION") and ctype != 5126:
-            hint = "bgr reads float positions: KHR_mesh_quantization is not supported"
+            hint = "integer positions need KHR_mesh_quantization in the file's extensionsUsed"
         fail(
             f"accessor {index}",
             f"{kind} of {COMPONENT_NAMES[ctype]} ({ctype}), but {use} must be "

@@ -7,7 +7,8 @@ against the file, a data URI's length against its ``byteLength`` before it is de
 file URI is read only inside the model's own folder (symlinks and ``..`` resolved, no URL or
 absolute path), like the ``mtllib`` of an OBJ.  Several buffers are joined into one, each
 bufferView checked to lie inside its own buffer first, so the rest of the reader
-(:mod:`.glb_read`) sees buffer 0 only.
+(:mod:`.glb_read`) sees buffer 0 only.  Views compressed by EXT_meshopt_compression are decoded
+into their places first (:mod:`.gltf_meshopt`).
 """
 
 from __future__ import annotations
@@ -22,6 +23,7 @@ from urllib.parse import unquote
 from bgr.grammar.paths import read_input, resolved
 
 from .gltf_checks import data_uri_payload, fail, quoted, view_span, whole
+from .gltf_meshopt import compressed, decoded
 
 JSON_CHUNK, BIN_CHUNK = 0x4E4F534A, 0x004E4942
 _SCHEME = re.compile(r"[A-Za-z][A-Za-z0-9+.-]*:")  # http:, file:, ... (not a relative path)
@@ -41,6 +43,8 @@ def parse(data: bytes, folder: Path | None = None) -> tuple[dict, bytes]:
     if not isinstance(buffers, list) or not buffers:
         return gltf, chunk or b""
     blobs = [_buffer(buffers, k, chunk, folder) for k in range(len(buffers))]
+    if compressed(gltf):  # EXT_meshopt_compression: the views decoded into their places
+        blobs = decoded(gltf, blobs)
     if len(blobs) == 1:
         return gltf, blobs[0]
     return gltf, _joined(gltf, blobs)

@@ -130,21 +130,14 @@ def _named_mesh(app, module, asset, path: Path, name: str) -> tuple[np.ndarray, 
     once per derivation however many of its meshes the grammar inserts."""
     files = app.engine.__dict__.setdefault("asset_files", {})
     if path not in files:
-        try:
-            import trimesh
+        from bgr.formats.glb_read import load, named_meshes
 
-            scene = trimesh.load(path, force="scene", process=False)
-            nodes = {}
-            for node in scene.graph.nodes_geometry:
-                matrix, geometry = scene.graph[node]
-                mesh = scene.geometry[geometry]
-                verts = np.asarray(mesh.vertices, dtype=float) @ matrix[:3, :3].T + matrix[:3, 3]
-                nodes[str(node)] = (verts, np.asarray(mesh.faces))
-        except Exception as e:  # any reader failure is the file's fault, not ours
+        try:  # bgr's reader: every number checked; meshopt-compressed and quantized files read
+            files[path] = named_meshes(*load(path))
+        except BgrError as e:
             raise runtime_error(
-                module, asset.pos, f"cannot read asset '{asset.path}': {e}"
+                module, asset.pos, f"cannot read asset '{asset.path}': {e.message}", e.hint
             ) from None
-        files[path] = nodes
     nodes = files[path]
     if name not in nodes:
         raise runtime_error(

@@ -78,6 +78,8 @@ def run(args) -> int:
         w_sigma=args.w_sigma,
         tau=args.tau,
         representative=args.representative,
+        compress=not args.plain_assets,
+        lod=args.lod,
         tolerance=args.tolerance,
         assets=named,
         progress=not args.no_progress and sys.stderr.isatty(),
@@ -91,7 +93,7 @@ def run(args) -> int:
     meshes = len(placed.terminals) - extruded + len(placed.carried)
     print(
         f"{terminal_text(args.input, keep='')}: {len(grammar.scene.objects)} objects, "
-        f"{len(grammar.comps)} components, {len(placed.terminals)} types at level "
+        f"{placed.components} components, {len(placed.terminals)} types at level "
         f"{placed.level.index} ({extruded} footprints extruded), {len(placed.rules)} "
         f"rules{wrote}"
         + (

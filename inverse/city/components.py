@@ -34,6 +34,21 @@ def digits_for(tolerance: float) -> int:
     return int(min(9, max(3, np.ceil(-np.log10(tolerance / 10)))))
 
 
+def grid_mesh(
+    vertices: np.ndarray, faces: np.ndarray, digits: int
+) -> tuple[np.ndarray, np.ndarray]:
+    """A mesh on the grammar's grid (``digits`` decimals: the lengths written are as short as
+    the grammar's), its equal vertices shared and the ones no triangle uses dropped."""
+    import trimesh
+
+    points = np.round(np.asarray(vertices, dtype=np.float64), digits)
+    mesh = trimesh.Trimesh(points, np.asarray(faces), process=False)
+    mesh.merge_vertices()
+    mesh.update_faces(mesh.nondegenerate_faces())  # a corner merged into another
+    mesh.remove_unreferenced_vertices()
+    return np.asarray(mesh.vertices), np.asarray(mesh.faces)
+
+
 KEY_GRID = key_grid(TOLERANCE)
 
 # the feature vector (paper, section IV.C), in units where 1 is a noticeable difference

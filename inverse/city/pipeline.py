@@ -13,7 +13,6 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
-import trimesh
 from tqdm import tqdm
 
 from bgr.grammar import nodes as n
@@ -25,11 +24,13 @@ from bgr.interpreter.limits import check_memory, restart_memory
 
 from . import emit, tree
 from .batch import building_stacks, decompose_all
-from .components import TOLERANCE, Component, digits_for, key_grid
-from .container import pack
+from .carried import Carried, carry
+from .components import TOLERANCE, Component, digits_for, grid_mesh, key_grid
+from .container import Mesh, pack
 from .model import CityScene
 from .prisms import fit_prism
 from .types import Level, Types, cluster, level_for
+from .uncut import uncut_unique
 
 MESHES = "meshes.glb"  # the one file of the assets folder: every type's mesh, a node each
 READ_COST = 10  # memory per byte of a text city file (OBJ, CityJSON) read, at least (20 measured)
@@ -49,6 +50,8 @@ class Options:
     representative: str = "mean"  # or "fewest" (triangles)
     tolerance: float = TOLERANCE  # metres: level 0's bound (components.key_grid)
     assets: str = "city.assets"  # the assets folder as the grammar names it
+    compress: bool = True  # the assets GLB quantized and meshopt-compressed (container.py)
+    lod: str | None = None  # CityJSON: the level of detail read (None: each object's highest)
     progress: bool = True
     seed: int = 0
 
@@ -63,9 +66,10 @@ class Placed:
     rules: list[tree.Rule]
     city: list[tree.Placement]
     units: list[emit.Unit]
-    carried: list[tuple[emit.Terminal, tree.Placement, np.ndarray, np.ndarray]]
+    carried: list[Carried]  # the objects that are not buildings, a mesh for each kind
     instances: list[tuple[int, np.ndarray, np.ndarray]]  # (terminal, world frame, size) each
     tau: float
+    components: int  # placed: at level 0, a building whose slabs were all unique counts once
 
 
 @dataclass
@@ -119,7 +123,13 @@ def decompose(scene: CityScene, options: Options) -> list[Component]:
 def place(
     scene: CityScene, comps: list[Component], types: Types, level: Level, options: Options
 ) -> Placed:
-    """The grammar's content at one level: terminals, building kinds, groups, the axiom."""
+    """The grammar's content at one level: terminals, building kinds, groups, the axiom.  At
+    level 0 a building cut into slabs that are each of a type of their own is whole again
+    (:mod:`.uncut`)."""
+    if level.index == 0:
+        key = key_grid(options.tolerance)
+        comps, types = uncut_unique(scene.objects, comps, types, options.tolerance, key)
+        level = types.levels[0]
     of_comp = level.of_base[types.base_of]
     count = np.bincount(of_comp, minlength=len(level.representative))
     order = sorted(range(len(count)), key=lambda t: (-count[t], t))
@@ -216,25 +226,19 @@ def place(
         top += tree.group(part, leaves, tau, grid, new_rule)
     city = _axiom(top)
 
-    carried = []
-    for obj in scene.objects:
-        if obj.proceduralize:
-            continue
-        low = obj.vertices.min(axis=0)
-        term = emit.Terminal(
-            f"Object{len(carried) + 1}",
-            f"object{len(carried) + 1}",
-            f"{options.assets}/{MESHES}#object{len(carried) + 1}",
-            _colour_of(obj.colors),
-            f"{comment_text(obj.kind, 60)} {comment_text(obj.name)}, carried as it is",
-        )
-        size = obj.vertices.max(axis=0) - low
-        carried.append(
-            (term, tree.Placement(term.name, 0.0, low, size), obj.vertices - low, obj.faces)
-        )
+    carried = carry(scene, f"{options.assets}/{MESHES}", _colour_of)
     repeated = synthesis_units(units)
     return Placed(
-        level, terminals, term_mesh, groups + rules, city, repeated, carried, instances, tau
+        level,
+        terminals,
+        term_mesh,
+        groups + rules,
+        city,
+        repeated,
+        carried,
+        instances,
+        tau,
+        len(comps),
     )
 
 
@@ -322,17 +326,6 @@ def _colour_of(colors: np.ndarray | None) -> str | None:
     return f"#{int(r):02x}{int(g):02x}{int(b):02x}"
 
 
-def _merged(vertices: np.ndarray, faces: np.ndarray, digits: int) -> tuple[np.ndarray, np.ndarray]:
-    """A mesh on the grammar's grid (``digits`` decimals: the lengths written are as short as
-    the grammar's), its equal vertices shared and the ones no triangle uses dropped."""
-    points = np.round(np.asarray(vertices, dtype=np.float64), digits)
-    mesh = trimesh.Trimesh(points, np.asarray(faces), process=False)
-    mesh.merge_vertices()
-    mesh.update_faces(mesh.nondegenerate_faces())  # a corner merged into another
-    mesh.remove_unreferenced_vertices()
-    return np.asarray(mesh.vertices), np.asarray(mesh.faces)
-
-
 def _reading_cost(path: str | Path) -> int:
     """The memory reading a city file takes, at least: READ_COST times its size (0 when it
     cannot be seen: the reader says why)."""
@@ -354,7 +347,7 @@ def infer_city(
 
     restart_memory()  # the ceiling (--max-memory) counts from here, the modules loaded
     check_memory("reading the city", _reading_cost(path))
-    scene = read_city(path, up=options.up)
+    scene = read_city(path, up=options.up, lod=options.lod)
     check_memory("reading the city")
     comps = decompose(scene, options)
     if not comps and not scene.objects:
@@ -384,12 +377,19 @@ def build(
     with _bar(options, len(placed.terminals) + len(placed.carried), "writing meshes") as bar:
         for t, rep in zip(placed.terminals, placed.term_mesh, strict=True):
             if t.prism is None:  # a footprint extruded is written as operations, not a mesh
-                named.append((t.asset, *_merged(rep.vertices, rep.faces, digits)))
+                named.append(Mesh(t.asset, *grid_mesh(rep.vertices, rep.faces, digits)))
             bar.update()
-        for t, _, vertices, faces in placed.carried:
-            named.append((t.asset, *_merged(vertices, faces, digits)))
+        for kind in placed.carried:
+            named.append(kind.mesh(digits, options.compress))
             bar.update()
-    assets = {MESHES: pack(named, "bgr infer --kind city")} if named else {}
+    packed = pack(
+        named,
+        "bgr infer --kind city",
+        compress=options.compress,
+        step=10.0**-digits,  # the grammar's grid: a mesh on it is stored exactly
+        coarsest=options.tolerance / 4,  # a mesh too large for 16 bits of that keeps floats
+    )
+    assets = {MESHES: packed} if named else {}
     header = _header(scene, comps, types, placed)
     module = emit.module(
         header,
@@ -397,7 +397,7 @@ def build(
         placed.rules,
         placed.city,
         placed.units,
-        [(t, p) for t, p, _, _ in placed.carried],
+        [(c.terminal, c.placement) for c in placed.carried],
         site_of(scene),
         exact=placed.level.index == 0,
         digits=digits,
@@ -410,7 +410,7 @@ def _header(scene: CityScene, comps: list[Component], types: Types, placed: Plac
     lines = [
         f"# Inferred by bgr infer --kind city from {comment_text(Path(scene.source).name)}: "
         f"{len(scene.objects)} objects,",
-        f"# {len(comps)} components in {len(placed.terminals)} types (level "
+        f"# {placed.components} components in {len(placed.terminals)} types (level "
         f"{placed.level.index} of {len(types.levels) - 1}), {len(placed.rules)} non-terminal "
         "rules;",
         f"# {extruded} of the types are footprints extruded (polygon, extrude), the others meshes;",
@@ -486,10 +486,10 @@ def rebuilt(placed: Placed) -> tuple[np.ndarray, np.ndarray]:
         verts.append(world)
         faces.append(rep.faces + count)
         count += len(world)
-    for _, p, vertices, f in placed.carried:
-        verts.append(vertices + p.offset)
-        faces.append(f + count)
-        count += len(vertices)
+    for kind in placed.carried:
+        verts.append(kind.vertices + kind.placement.offset)
+        faces.append(kind.faces + count)
+        count += len(verts[-1])
     if not verts:
         return np.zeros((0, 3)), np.zeros((0, 3), dtype=np.int64)
     return np.concatenate(verts), np.concatenate(faces)
@@ -520,13 +520,13 @@ def level_stats(source: str | Path, grammar: CityGrammar, options: Options) -> l
         rows.append(
             {
                 "level": level.index,
-                "components": len(comps),
+                "components": placed.components,
                 "terminals": len(placed.terminals) + len(placed.carried),
                 "nonterminals": len(placed.rules) + 3,  # and Lot, City, Synthesis
                 "rules": len(placed.rules) + 4 + len(placed.terminals) + len(placed.carried),
                 "input_triangles": int(len(in_f)),
                 "output_triangles": int(sum(len(m.faces) for m in placed.term_mesh))
-                + int(sum(len(f) for *_, f in placed.carried)),
+                + int(sum(len(kind.faces) for kind in placed.carried)),
                 "input_bytes": Path(source).stat().st_size,
                 "output_bytes": len(text.encode()) + sum(len(b) for b in built.assets.values()),
                 "hausdorff": d.hausdorff,

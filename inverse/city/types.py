@@ -61,15 +61,7 @@ def cluster(
 ) -> Types:
     """Level 0 by equal meshes, then the k-means hierarchy on the level-0 types; ``progress``
     (a tqdm bar) counts the level-0 types as their feature vectors are made."""
-    keys = [c.key for c in components]
-    unique, first, base_of, count = np.unique(
-        np.array(keys), return_index=True, return_inverse=True, return_counts=True
-    )
-    order = np.argsort(first, kind="stable")  # types numbered by first appearance
-    renumber = np.empty(len(order), dtype=np.int64)
-    renumber[order] = np.arange(len(order))
-    base_of = renumber[base_of.reshape(-1)]
-    first, count = first[order], count[order]
+    base_of, first, count = _equal_meshes(components)
     w = weights(feature_weights)
     vectors = np.array([_counted(features(components[i]), progress) for i in first]) * w
     triangles = np.array([len(components[i].faces) for i in first])
@@ -94,6 +86,27 @@ def cluster(
         error = float(np.max(np.linalg.norm(vectors - vectors[reps[labels]], axis=1)))
         levels.append(Level(len(levels), labels.copy(), reps, error))
     return Types(base_of, first, count, vectors, levels)
+
+
+def _equal_meshes(components: list[Component]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Level 0: (the type of each component, a component of each type, instances of each type),
+    components of one key being one type, types numbered by first appearance."""
+    keys = [c.key for c in components]
+    unique, first, base_of, count = np.unique(
+        np.array(keys), return_index=True, return_inverse=True, return_counts=True
+    )
+    order = np.argsort(first, kind="stable")
+    renumber = np.empty(len(order), dtype=np.int64)
+    renumber[order] = np.arange(len(order))
+    return renumber[base_of.reshape(-1)], first[order], count[order]
+
+
+def base_types(components: list[Component]) -> Types:
+    """Level 0 alone (no feature vectors, no hierarchy above it): what a level-0 grammar needs."""
+    base_of, first, count = _equal_meshes(components)
+    n0 = len(first)
+    level0 = Level(0, np.arange(n0), np.arange(n0), 0.0)
+    return Types(base_of, first, count, np.zeros((n0, len(FEATURES))), [level0])
 
 
 def _counted(value, progress):
