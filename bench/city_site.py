@@ -200,10 +200,10 @@ def main() -> None:
                 grammar = Path(tmp) / "city.bgr"
                 bgr("infer", str(alone), "--no-progress", "-o", str(grammar))
                 text, assets = grammar.stat().st_size, folder_bytes(Path(tmp) / "city.assets")
-                obj = alone.stat().st_size
+                alone_obj = alone.stat().st_size
                 sizes.append(
-                    f"| {path.name}, buildings only | | {obj:,} | {text:,} | {assets:,} | "
-                    f"{(text + assets) / obj:.2f} |"
+                    f"| {path.name}, buildings only | | {alone_obj:,} | {text:,} | {assets:,} | "
+                    f"{(text + assets) / alone_obj:.2f} |"
                 )
         if "--levels" in flags:
             coarse += levels(path, truth, obj, lod, name)
