@@ -266,3 +266,19 @@ def test_lod_picks_the_level_of_detail_inferred(tmp_path, capsys):
     obj.write_text("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n")
     assert main(["infer", str(obj), "--lod", "1.2", "-o", str(tmp_path / "d.bgr")]) == 1
     assert "level of detail" in capsys.readouterr().err
+
+
+def test_position_bounds_are_the_decoded_values(tmp_path):
+    """glTF wants an accessor's min and max to be its data's: for quantized and filtered views,
+    the values a reader decodes, not the floats before the filter."""
+    from bgr.formats.glb_read import accessor
+
+    path = tmp_path / "meshes.glb"
+    path.write_bytes(pack(meshes(), compress=True, step=STEP, coarsest=0.0025))
+    gltf, blob = load(path)
+    for mesh in gltf["meshes"]:
+        index = mesh["primitives"][0]["attributes"]["POSITION"]
+        values = accessor(gltf, blob, index).astype(np.float32)
+        acc = gltf["accessors"][index]
+        assert values.min(axis=0).tolist() == [np.float32(v) for v in acc["min"]]
+        assert values.max(axis=0).tolist() == [np.float32(v) for v in acc["max"]]

@@ -4,6 +4,7 @@ against the input, and the one assets file of the meshes that remain (issue 29).
 from __future__ import annotations
 
 import json
+import re
 import struct
 
 import numpy as np
@@ -146,3 +147,20 @@ def test_the_assets_file_is_valid_gltf(validator, tmp_path):  # noqa: F811
     path.write_bytes(pack(meshes()))
     report = validate(validator, [path])[str(path)]
     assert report["errors"] == 0 and report["warnings"] == 0, clean(report)
+
+
+def test_a_block_without_its_floor_derives_back_through_the_shared_rule(tmp_path):
+    """An LoD1 block with walls and a roof but no ground face: ``WallsAndRoof(h)``, shared by
+    every such block, keeps the walls and the roof and makes no floor."""
+    src = tmp_path / "l.obj"
+    keep(l_block(), lambda up: up > -0.5).export(src)  # the floor left out
+    out = tmp_path / "city.bgr"
+    assert bgr.cli.main(["infer", str(src), "--up", "y", "-o", str(out), "--no-progress"]) == 0
+    text = out.read_text()
+    assert re.search(r"Type1 --> polygon\([^)]*\) WallsAndRoof\(9\)", text)
+    assert "WallsAndRoof(h) --> extrude(h) comp(f) { side: Wall | top: Roof }" in text
+    result = bgr.derive(bgr.load(out))
+    assert set(result.terminals.label) == {"Wall", "Roof"}
+    baked = bgr.formats.meshes.bake(result.terminals)
+    made = trimesh.Trimesh(baked.vertices, baked.faces)
+    assert made.area == pytest.approx(keep(l_block(), lambda up: up > -0.5).area, rel=1e-6)

@@ -55,6 +55,7 @@ class _View:
     target: int
     data: bytearray = field(default_factory=bytearray)
     rows: int = 0
+    filtered: bool = False  # rows already through meshopt's exponential filter
 
     def add(self, rows: np.ndarray) -> int:
         """Append rows (n, width) and return the byte offset they start at.  (An accessor's
@@ -86,12 +87,12 @@ def pack(
         "small": _View("<u2", 1, ELEMENT_ARRAY_BUFFER),
         "large": _View("<u4", 1, ELEMENT_ARRAY_BUFFER),
         "grid": _View("<u2", 4, ARRAY_BUFFER),  # 4-byte aligned rows: x, y, z, padding
-        "float": _View("<f4", 3, ARRAY_BUFFER),
+        # compressed: the exponential filter's int32 codes of the floats (see _exponential)
+        "float": _View("<i4" if compress else "<f4", 3, ARRAY_BUFFER, filtered=compress),
     }
     accessors: list[dict] = []
     meshes: list[dict] = []
     nodes: list[dict] = []
-    largest = 0.0  # the largest float coordinate: the exponential filter's precision
     for item in named:
         mesh = item if isinstance(item, Mesh) else Mesh(*item)
         if len(mesh.faces) == 0:
@@ -106,13 +107,17 @@ def pack(
         grid = _grid_step(points, step, coarsest) if compress else None
         if grid is None:
             rows = points.astype("<f4")
+            values = rows
+            if compress:  # the filter's codes are stored; the accessor's bounds are their values
+                rows = _exponential(rows, _exponent_bits(float(np.abs(rows).max()), step))
+                values = _exponential_values(rows)
             position_view = "float"
-            largest = max(largest, float(np.abs(rows).max()))
         else:
             low = np.round(points.min(axis=0) / step) * step
             cells = np.rint((points - low) / grid).astype(np.int64)
             rows = np.column_stack([cells, np.zeros(len(cells), dtype=np.int64)])
             position_view = "grid"
+            values = cells
             node |= {"scale": [grid] * 3}
             if np.any(low != 0):
                 node |= {"translation": [float(v) for v in low]}
@@ -125,15 +130,14 @@ def pack(
                 "type": "SCALAR",
             }
         )
-        values = rows[:, :3]
         accessors.append(
             _at({"bufferView": kinds.index(position_view)}, views[position_view].add(rows))
             | {
                 "componentType": UNSIGNED_SHORT if position_view == "grid" else FLOAT,
                 "count": len(rows),
                 "type": "VEC3",
-                "min": [_shortest(v) for v in values.min(axis=0).astype(rows.dtype)],
-                "max": [_shortest(v) for v in values.max(axis=0).astype(rows.dtype)],
+                "min": [_shortest(v) for v in values.min(axis=0)],
+                "max": [_shortest(v) for v in values.max(axis=0)],
             }
         )
         meshes.append(
@@ -151,8 +155,7 @@ def pack(
         renumber = {list(views).index(k): i for i, k in enumerate(used)}
         for acc in accessors:
             acc["bufferView"] = renumber[acc["bufferView"]]
-        bits = _exponent_bits(largest, step) if compress and "float" in used else None
-        view_list, buffers, body = _views(list(used.values()), compress, bits)
+        view_list, buffers, body = _views(list(used.values()), compress)
         gltf |= {
             "scene": 0,
             "scenes": [{"nodes": list(range(len(nodes)))}],
@@ -173,13 +176,10 @@ def pack(
     return struct.pack("<III", GLB_MAGIC, GLB_VERSION, 12 + len(chunks)) + chunks
 
 
-def _views(
-    used: list[_View], compress: bool, bits: int | None = None
-) -> tuple[list[dict], list[dict], bytes]:
+def _views(used: list[_View], compress: bool) -> tuple[list[dict], list[dict], bytes]:
     """(bufferViews, buffers, the BIN chunk) for the filled views: plain, one after another in
     buffer 0; or compressed, their codes in buffer 0 and the views themselves in buffer 1, a
-    fallback buffer with no data (EXT_meshopt_compression), float positions through the
-    exponential filter with ``bits`` of mantissa."""
+    fallback buffer with no data (EXT_meshopt_compression)."""
     body, plain, out = bytearray(), 0, []
     for view in used:
         plain += -plain % 4  # each view starts on a 4-byte boundary
@@ -189,8 +189,7 @@ def _views(
             entry["byteStride"] = view.stride  # the accessors share the view: glTF wants it said
         entry["target"] = view.target
         if compress:
-            filtered = bits is not None and view.dtype == "<f4"
-            code = _encoded(view, bits if filtered else None)
+            code = _encoded(view)
             at = len(body)
             body += code + b"\0" * (-len(code) % 4)
             entry["extensions"] = {
@@ -202,7 +201,7 @@ def _views(
                     "mode": "ATTRIBUTES" if view.target == ARRAY_BUFFER else "TRIANGLES",
                 }
                 | ({"byteOffset": at} if at else {})
-                | ({"filter": "EXPONENTIAL"} if filtered else {})
+                | ({"filter": "EXPONENTIAL"} if view.filtered else {})
             }
         else:
             body += b"\0" * (plain - len(body)) + view.data
@@ -215,21 +214,33 @@ def _views(
     return out, [{"byteLength": len(body)}, fallback], bytes(body)
 
 
-def _encoded(view: _View, bits: int | None = None) -> bytes:
-    """A view's bytes as meshoptimizer encodes them: vertex rows by its attribute codec (float
-    rows first through its exponential filter, ``bits`` of mantissa, where given), a triangle
-    list (every mesh's, one after another) by its index codec."""
+def _encoded(view: _View) -> bytes:
+    """A view's bytes as meshoptimizer encodes them: vertex rows by its attribute codec, a
+    triangle list (every mesh's, one after another) by its index codec."""
     import meshopt
 
     data = np.frombuffer(bytes(view.data), dtype=view.dtype)
     if view.target == ARRAY_BUFFER:
-        rows = data.reshape(view.rows, view.width)
-        if bits is not None:
-            # one exponent per component for all rows: fixed point, whose deltas compress
-            rows = meshopt.encode_filter_exp(rows, bits, "SharedComponent")
-            rows = np.ascontiguousarray(rows).view(np.uint8).reshape(view.rows, -1)
-        return meshopt.encode_gltf_buffer(rows, "ATTRIBUTES")
+        return meshopt.encode_gltf_buffer(data.reshape(view.rows, -1), "ATTRIBUTES")
     return meshopt.encode_gltf_buffer(data, "TRIANGLES")
+
+
+def _exponential(rows: np.ndarray, bits: int) -> np.ndarray:
+    """Float rows (n, 3) as meshoptimizer's exponential filter stores them (one int32 each: an
+    8-bit exponent over a 24-bit mantissa of ``bits`` significant bits), one exponent per
+    component for the mesh: fixed point, whose deltas its attribute codec compresses."""
+    import meshopt
+
+    codes = meshopt.encode_filter_exp(np.ascontiguousarray(rows, "<f4"), bits, "SharedComponent")
+    return np.ascontiguousarray(codes).view("<i4").reshape(len(rows), 3)
+
+
+def _exponential_values(codes: np.ndarray) -> np.ndarray:
+    """The floats a reader decodes from exponential-filter codes: mantissa x 2^exponent."""
+    codes = codes.astype(np.int64)
+    exponent = codes >> 24  # arithmetic shift: the signed top byte
+    mantissa = ((codes & 0xFFFFFF) ^ 0x800000) - 0x800000  # the signed low 24 bits
+    return np.ldexp(mantissa.astype(np.float64), exponent).astype("<f4")
 
 
 def _exponent_bits(largest: float, step: float) -> int:
