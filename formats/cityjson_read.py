@@ -52,6 +52,7 @@ class CityModel:
     objects: dict[str, CityObjectMesh]
     reference_system: str | None = None
     transform: dict | None = None
+    lods: set[str] = field(default_factory=set)  # every geometry's lod the file has
 
 
 def read_cityjson(path: str | Path, lod: str | None = None) -> CityModel:
@@ -90,6 +91,7 @@ def read_cityjson(path: str | Path, lod: str | None = None) -> CityModel:
             vertices = vertices.reshape(-1, 3)
             for ident, obj in doc["CityObjects"].items():
                 try:
+                    model.lods.update(_lods(obj))
                     model.objects[ident] = _read_object(ident, obj, vertices, lod)
                 except ValueError as exc:
                     raise ValueError(f"city object {ident[:80]!r}: {exc}") from None
@@ -127,6 +129,14 @@ _DEPTH = {
     "MultiSolid": 2,
     "CompositeSolid": 2,
 }
+
+
+def _lods(obj: Any) -> set[str]:
+    """The lods of a city object's geometries (what ``lod`` may pick), as the file writes them."""
+    geoms = obj.get("geometry") if isinstance(obj, dict) else None
+    if not isinstance(geoms, list):
+        return set()
+    return {str(g["lod"])[:20] for g in geoms if isinstance(g, dict) and "lod" in g}
 
 
 def _read_object(ident: str, obj: dict, vertices: np.ndarray, lod: str | None) -> CityObjectMesh:

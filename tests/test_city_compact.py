@@ -260,7 +260,7 @@ def test_lod_picks_the_level_of_detail_inferred(tmp_path, capsys):
     assert main(["infer", str(city), "-o", str(tmp_path / "b.bgr")]) == 0
     assert "0 footprints extruded" in capsys.readouterr().err  # 2.2, the highest: a mesh
     assert main(["infer", str(city), "--lod", "3", "-o", str(tmp_path / "c.bgr")]) == 1
-    assert "lod 3" in capsys.readouterr().err
+    assert "lod 3; the file has lods 1.2, 2.2" in capsys.readouterr().err
     assert not (tmp_path / "c.bgr").exists()
     obj = tmp_path / "one.obj"
     obj.write_text("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n")

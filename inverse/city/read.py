@@ -796,6 +796,13 @@ def _gathered(parts: list[tuple[str, trimesh.Trimesh, dict]]) -> Found:
 # CityJSON
 
 
+def _lod_order(lod: str) -> tuple[float, str]:
+    try:
+        return float(lod), lod
+    except ValueError:
+        return float("inf"), lod
+
+
 def _read_cityjson(path: str | Path, lod: str | None) -> Found:
     """Every city object with triangles: Buildings and BuildingParts to proceduralize, the
     rest (roads, land use, water, terrain...) carried.  A Building whose geometry is all in
@@ -822,7 +829,10 @@ def _read_cityjson(path: str | Path, lod: str | None) -> Found:
         )
         count += len(mesh.vertices)
     crs = model.reference_system
-    hint = f"no city object has geometry of lod {lod}" if lod is not None else None
+    hint = None
+    if lod is not None:
+        has = ", ".join(sorted(model.lods, key=_lod_order)[:12]) or "none"
+        hint = f"no city object has geometry of lod {lod[:40]}; the file has lods {has}"
     if not faces:
         return Found(
             np.zeros((0, 3)), np.zeros((0, 3), dtype=np.int64), None, None, crs=crs, hint=hint
