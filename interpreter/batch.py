@@ -42,8 +42,9 @@ from .lots import Lot, attr_overrides
 from .terminals import TerminalTable
 from .workers import Pool
 
-# the split cache (pure: sizes -> placed pieces) is kept across the lots one process derives,
-# and emptied when it holds more entries than this, so that a long run does not grow with it
+# the split cache (pure: sizes -> placed pieces; it also holds reuse.py's analysis of the
+# grammar, Reuse.share) is kept across the lots one process derives, and emptied when it holds
+# more entries than this, so that a long run does not grow with it
 CACHE_ENTRIES = 50_000
 
 # job token -> this process's resident memory when it began deriving that run's lots: the
@@ -137,6 +138,7 @@ def derive_lot(
         table = engine.table
         if cache is not None:
             engine.split_cache = cache
+            engine.reuse.share(cache)
         engine.shapes, engine.triangles = shapes, triangles
         try:
             engine.derive(lot.shape.copy(), job.start, index=index, several=job.several)
