@@ -47,11 +47,18 @@ class MeshLibrary:
         self.meshes: list[UnitMesh] = []
         self._index: dict[tuple, int] = {}
 
+    @staticmethod
+    def key(mesh: UnitMesh) -> tuple:
+        """What makes two meshes the same one: name, and vertices, faces (and an asset's
+        texture coordinates and image) to 12 decimals."""
+        key: tuple = (mesh.name, mesh.vertices.round(12).tobytes(), mesh.faces.tobytes())
+        if mesh.uv is not None:  # a textured asset is another mesh than its bare shape
+            key += (mesh.uv.round(12).tobytes(), getattr(mesh.image, "path", None))
+        return key
+
     def add(self, mesh: UnitMesh, key: tuple | None = None) -> int:
         if key is None:
-            key = (mesh.name, mesh.vertices.round(12).tobytes(), mesh.faces.tobytes())
-            if mesh.uv is not None:  # a textured asset is another mesh than its bare shape
-                key += (mesh.uv.round(12).tobytes(), getattr(mesh.image, "path", None))
+            key = self.key(mesh)
         found = self._index.get(key)
         if found is None:
             found = self._index[key] = len(self.meshes)
