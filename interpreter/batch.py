@@ -39,12 +39,14 @@ from bgr.grammar.parser import no_gc
 from .engine import Engine
 from .limits import default_max_memory, memory_in_use
 from .lots import Lot, attr_overrides
+from .shared import forget, share
 from .terminals import TerminalTable
 from .workers import Pool
 
-# the split cache (pure: sizes -> placed pieces; it also holds reuse.py's analysis of the
-# grammar, Reuse.share) is kept across the lots one process derives, and emptied when it holds
-# more entries than this, so that a long run does not grow with it
+# the split cache (pure: sizes -> placed pieces) is kept across the lots one process derives,
+# and emptied when it holds more entries than this, so that a long run does not grow with it;
+# it also keeps reuse.py's analysis of the grammar (Reuse.share) and the compiled expressions
+# and plans (shared.py)
 CACHE_ENTRIES = 50_000
 
 # job token -> this process's resident memory when it began deriving that run's lots: the
@@ -139,6 +141,7 @@ def derive_lot(
         if cache is not None:
             engine.split_cache = cache
             engine.reuse.share(cache)
+            share(engine, cache)
         engine.shapes, engine.triangles = shapes, triangles
         try:
             engine.derive(lot.shape.copy(), job.start, index=index, several=job.several)
@@ -230,16 +233,20 @@ def derive_lots(
 def _serial(job: Job, numbered: Iterator[tuple[int, Lot]]) -> Iterator[LotResult]:
     cache: dict = {}
     shapes = triangles = 0
-    for index, lot in numbered:
-        if len(cache) > CACHE_ENTRIES:
-            cache.clear()
-        result = derive_lot(job, index, lot, shapes=shapes, triangles=triangles, cache=cache)
-        if result.error is not None:
-            raise result.error
-        if not job.per_lot:
-            shapes += result.shapes
-            triangles += result.triangles
-        yield result
+    try:
+        for index, lot in numbered:
+            if len(cache) > CACHE_ENTRIES:
+                forget(cache)
+                cache.clear()
+            result = derive_lot(job, index, lot, shapes=shapes, triangles=triangles, cache=cache)
+            if result.error is not None:
+                raise result.error
+            if not job.per_lot:
+                shapes += result.shapes
+                triangles += result.triangles
+            yield result
+    finally:
+        forget(cache)  # the compiled expressions' reference cycles, not left to the collector
 
 
 def _checked(job: Job, result: LotResult, shapes: int, triangles: int) -> LotResult:
@@ -297,11 +304,13 @@ def derive_batch(job: Job, batch: list[tuple[int, Lot]]) -> list[LotResult]:
     after it would not be written)."""
     global _CACHE_OF
     if job.token != _CACHE_OF:  # a cache's keys are ids of one grammar's nodes
+        forget(_CACHE)
         _CACHE.clear()
         _CACHE_OF = job.token
     out = []
     for index, lot in batch:
         if len(_CACHE) > CACHE_ENTRIES:
+            forget(_CACHE)
             _CACHE.clear()
         result = derive_lot(job, index, lot, cache=_CACHE)
         out.append(result)

@@ -159,6 +159,8 @@ class Engine:
         self.defaults: dict[int, tuple] = {}  # id(rule) -> Application.fill_defaults' plan
         # (id(successor), id(target module), target rule) -> Application.binder's plan
         self.binders: dict[tuple, tuple] = {}
+        # the compilers and plans above are the run's, kept for its other lots (shared.py)
+        self.shared = False
 
     def _prepare_values(self, grammar, overrides: dict) -> dict:
         unknown = [k for k in overrides if k not in grammar.attrs]
@@ -244,9 +246,9 @@ class Engine:
                     reuse.record(self, *item[1:])
                     continue
                 shape, module, rule_node, args, indices = item
-                key = reuse.key(shape, module, rule_node, args)
-                if key is not None:
-                    found = reuse.records.get(key)
+                known = reuse.lookup(shape, module, rule_node, args)
+                if known is not None:
+                    key, found = known
                     if found is not None and reuse.replay(
                         self, key, found, shape, module, rule_node.pos
                     ):
@@ -274,7 +276,10 @@ class Engine:
     def release(self) -> None:
         """Drop the derivation's compiled expressions and plans: they hold the engine and its
         compilers in reference cycles, which otherwise wait for the cyclic collector (55,000
-        objects after a style sheet's derivation, 0.1 s to collect)."""
+        objects after a style sheet's derivation, 0.1 s to collect).  Shared ones are left to
+        the run's other lots (shared.forget drops them)."""
+        if self.shared:
+            return
         for compiler in self.compilers.values():
             compiler.funcs.clear()
         self.compilers.clear()

@@ -27,6 +27,7 @@ from bgr.grammar.registry import OPERATIONS
 from .expressions import RuleRef
 from .geometry.polygons import RECT
 from .limits import MEMORY_CHECK_EVERY
+from .shapes import Flat, Prism, Solid
 
 # names whose value depends on where the shape is, or on its place among its siblings
 PLACED = {
@@ -246,42 +247,53 @@ class Reuse:
         every lot was 2 % of Helsinki's time."""
         self.known, self.worth = cache.setdefault(ANALYSIS, (self.known, self.worth))
 
-    def key(self, shape, module, rule: n.Rule, args: dict):
-        """The key of a rule applied to a shape, or None when its subtree is not reusable (or
-        is one terminal, which costs no more to derive than to replay)."""
+    def lookup(self, shape, module, rule: n.Rule, args: dict) -> tuple | None:
+        """(key, its record or None) of a rule applied to a shape, or None when its subtree is
+        not reusable (or is one terminal, which costs no more to derive than to replay).
+
+        The key is made of plain tuples, ids and values, so that hashing it, as every lookup
+        does, runs no Python ``__hash__`` (a geometry's or a rule reference's: 1.1 million
+        calls on Helsinki)."""
         worth = self.worth.get(id(rule))
         if worth is None:
             worth = self.worth[id(rule)] = _spawns(rule) and reusable(module, rule.name, self.known)
         if not worth or shape.tex is not None:
             return None
         geom = shape.geom
-        polys = getattr(geom, "polys", None)
-        if polys is not None and polys != RECT:
-            geom = (type(geom).__name__, geom.k, geom.name, tuple(polys))
-        for value in args.values():  # a rule handed over: its own subtree must be reusable
-            if (
-                isinstance(value, RuleRef)
-                and value.member in value.module.rules
-                and not reusable(value.module, value.member, self.known)
-            ):
-                return None
+        kind = geom.__class__
+        if kind is Flat or kind is Prism:
+            polys = geom.polys
+            geom = (kind, geom.k, geom.name, polys if polys == RECT else tuple(polys))
+        elif kind is Solid:
+            geom = (kind, geom.mesh, geom.name)
+        named: tuple = ()
+        if args:
+            items = []
+            for name, value in sorted(args.items()):
+                if isinstance(value, RuleRef):  # a rule handed over: its subtree must be reusable
+                    if value.member in value.module.rules and not reusable(
+                        value.module, value.member, self.known
+                    ):
+                        return None
+                    value = (RuleRef, id(value.module), value.member)
+                items.append((name, value))
+            named = tuple(items)
+        key = (
+            id(module),
+            id(rule),
+            named,
+            tuple(shape.size),
+            shape.axes,
+            geom,
+            shape.color,
+            shape.material,
+            shape.label,
+            shape.depth,
+        )
         try:
-            key = (
-                id(module),
-                id(rule),
-                tuple(sorted(args.items())) if args else (),
-                tuple(shape.size),
-                shape.axes,
-                geom,
-                shape.color,
-                shape.material,
-                shape.label,
-                shape.depth,
-            )
-            hash(key)
+            return key, self.records.get(key)
         except TypeError:  # an argument or a geometry that cannot be a key
             return None
-        return key
 
     def record(self, engine, key, where: tuple, start: int, marks: tuple) -> None:
         """Move the rows a subtree emitted (``start`` on, derived at the world's origin) to
