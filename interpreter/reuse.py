@@ -54,6 +54,12 @@ FIRST_MOST = 256
 KEEP_MOST = 50_000
 # the key under which Reuse.share keeps the analysis in a shared cache
 ANALYSIS = "reuse.analysis"
+# a rule whose first this many lookups all found nothing is not looked up any more (Helsinki:
+# a façade row's end margins, 19,494 lookups, and its first tile, 15,204, never find a record,
+# for the replayed floor holds them); its subtrees are still derived at the origin and moved
+GIVE_UP = 256
+MOVED = "moved only"  # Reuse.worth's mark of such a rule
+UNSOUGHT = (None, None)  # Reuse.lookup's answer for it: no key, no record
 TEXTURING = {name for name, op in OPERATIONS.items() if op.family == "texturing"}
 
 
@@ -234,7 +240,9 @@ class Reuse:
     def __init__(self, replay: bool = True) -> None:
         self.replaying = replay
         self.known: dict = {}  # (id(module), rule name) -> reusable?
-        self.worth: dict = {}  # id(rule) -> reusable and making more than one shape?
+        # id(rule) -> reusable and making more than one shape? (MOVED: given up looking up)
+        self.worth: dict = {}
+        self.tries: dict = {}  # id(rule) -> lookups that found nothing; -1 once one found one
         self.seen: set = set()
         self.records: OrderedDict = OrderedDict()  # least recently replayed first
         self.rows = 0  # rows the records hold, at most KEEP_MOST
@@ -245,7 +253,9 @@ class Reuse:
         lots of one run share (batch.derive_lot's split cache, whose keys are ids of one
         grammar's nodes too): it depends on the grammar alone, and working it out again for
         every lot was 2 % of Helsinki's time."""
-        self.known, self.worth = cache.setdefault(ANALYSIS, (self.known, self.worth))
+        self.known, self.worth, self.tries = cache.setdefault(
+            ANALYSIS, (self.known, self.worth, self.tries)
+        )
 
     def lookup(self, shape, module, rule: n.Rule, args: dict) -> tuple | None:
         """(key, its record or None) of a rule applied to a shape, or None when its subtree is
@@ -259,6 +269,11 @@ class Reuse:
             worth = self.worth[id(rule)] = _spawns(rule) and reusable(module, rule.name, self.known)
         if not worth or shape.tex is not None:
             return None
+        if worth is MOVED:  # derived at the origin wherever a lookup would have been made
+            for value in args.values():
+                if isinstance(value, RuleRef) and not self._handed_ok(value):
+                    return None
+            return UNSOUGHT
         geom = shape.geom
         kind = geom.__class__
         if kind is Flat or kind is Prism:
@@ -270,10 +285,8 @@ class Reuse:
         if args:
             items = []
             for name, value in sorted(args.items()):
-                if isinstance(value, RuleRef):  # a rule handed over: its subtree must be reusable
-                    if value.member in value.module.rules and not reusable(
-                        value.module, value.member, self.known
-                    ):
+                if isinstance(value, RuleRef):
+                    if not self._handed_ok(value):
                         return None
                     value = (RuleRef, id(value.module), value.member)
                 items.append((name, value))
@@ -291,9 +304,23 @@ class Reuse:
             shape.depth,
         )
         try:
-            return key, self.records.get(key)
+            found = self.records.get(key)
         except TypeError:  # an argument or a geometry that cannot be a key
             return None
+        tries = self.tries.get(id(rule), 0)
+        if found is not None:
+            if tries >= 0:
+                self.tries[id(rule)] = -1  # looked up from now on, however often it misses
+        elif tries >= 0:
+            self.tries[id(rule)] = tries + 1
+            if tries + 1 >= GIVE_UP:
+                self.worth[id(rule)] = MOVED
+        return key, found
+
+    def _handed_ok(self, ref: RuleRef) -> bool:
+        """Whether a rule handed over in an argument keeps its receiver reusable: a terminal,
+        or a rule whose own subtree is reusable."""
+        return ref.member not in ref.module.rules or reusable(ref.module, ref.member, self.known)
 
     def record(self, engine, key, where: tuple, start: int, marks: tuple) -> None:
         """Move the rows a subtree emitted (``start`` on, derived at the world's origin) to
@@ -305,7 +332,7 @@ class Reuse:
         local = t.origin[start:]
         if ox or oy or oz:  # a piece at its parent's corner (the first of a split) stays put
             t.origin[start:] = [(x + ox, y + oy, z + oz) for x, y, z in local]
-        if not self.replaying:
+        if key is None or not self.replaying:  # UNSOUGHT: moved, not kept
             return
         if key not in self.seen and len(local) > FIRST_MOST:
             self.seen.add(key)  # a large subtree is kept once it repeats (a façade rarely does)
