@@ -153,7 +153,8 @@ class Engine:
         # id(operation node) -> its signature (the grammar outlives us)
         self.signatures: dict[int, tuple] = {}
         self.uses_center: dict[int, bool] = {}  # id(step list) -> does it call center()?
-        # id(successor) -> (module, member, member's name hash, its rule or None if a terminal)
+        # id(successor) -> (module, member, member's name hash, its rule or None if a terminal,
+        # Application.binder's plan)
         self.targets: dict[int, tuple] = {}
         self.rule_locals: dict[int, frozenset] = {}  # id(rule) -> its parameter names
         self.defaults: dict[int, tuple] = {}  # id(rule) -> Application.fill_defaults' plan
@@ -267,7 +268,15 @@ class Engine:
                     stack.append((RECORDED, key, where, len(table.label), marks))
                 app = Application(self, shape, module, rule_node, args, indices)
                 app.run()
-                stack.extend(reversed(app.children))
+                children = app.children
+                done = 0
+                for child in children:  # terminals before the first rule: emitted now, in order
+                    if child[0] is not EMIT:
+                        break
+                    self.emit(*child[1:])
+                    done += 1
+                if done < len(children):
+                    stack.extend(reversed(children[done:] if done else children))
         finally:
             if gc_was_on:
                 gc.enable()
@@ -642,17 +651,22 @@ class Application:
         engine = self.engine
         if step.name in self.local:  # a rule handed over in a parameter
             module, member = self.target(step)
-            found = (module, member, _name_hash(member), _rule_of(module, member))
+            member_hash, rule, plan = _name_hash(member), _rule_of(module, member), None
         else:
             found = engine.targets.get(id(step))
-            if found is None:
+            if found is None:  # the target and binder's plan, worked out once per successor
                 module, member = self.module.lookup_module(step.name)
-                found = (module, member, _name_hash(member), _rule_of(module, member))
+                plan = self.binder(module, member, step) if step.args else ()
+                found = (module, member, _name_hash(member), _rule_of(module, member), plan)
                 engine.targets[id(step)] = found
-        module, member, member_hash, rule = found
+            module, member, member_hash, rule, plan = found
         if member in module.barren:  # a rule that can never end in a terminal
             handed(engine, self.module, step, module.barren[member])
-        args = self.bind(module, member, step) if step.args else {}
+        if plan is None:
+            args = self.bind(module, member, step) if step.args else {}
+        else:
+            ctx = self.ctx
+            args = {name: fn(ctx) for name, fn in plan} if plan else {}
         child = shape if handover else shape.copy()
         index = self.counter
         self.counter += 1
