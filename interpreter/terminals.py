@@ -81,6 +81,19 @@ def _floats(rows: list, shape: tuple[int, ...]) -> np.ndarray:
     return data.reshape(-1, *shape)
 
 
+def _shared_floats(rows: list, shape: tuple[int, ...]) -> np.ndarray:
+    """:func:`_floats` of rows that are mostly the same few objects (the axes: every copy of a
+    shape, and every replayed row, holds its parent's tuple): each distinct object converted
+    once and gathered by identity (Helsinki: 730,863 rows of axes, 0.18 s -> 0.06 s)."""
+    if not rows:
+        return _floats(rows, shape)
+    ids = np.fromiter(map(id, rows), dtype=np.int64, count=len(rows))
+    _, first, where = np.unique(ids, return_index=True, return_inverse=True)
+    if 2 * len(first) > len(rows):  # mostly distinct: nothing to share
+        return _floats(rows, shape)
+    return _floats([rows[i] for i in first.tolist()], shape)[where.reshape(-1)]
+
+
 @dataclass
 class TerminalTable:
     """Columns of the terminal list (LANGUAGE.md section 11), in derivation order."""
@@ -130,7 +143,7 @@ class TerminalTable:
     def freeze(self) -> TerminalTable:
         if not self.frozen:
             self.origin = _floats(self.origin, (3,))
-            self.axes = _floats(self.axes, (3, 3))
+            self.axes = _shared_floats(self.axes, (3, 3))
             self.size = _floats(self.size, (3,))
             self.color = _floats(self.color, (3,))
             self.mesh = np.asarray(self.mesh, dtype=np.int32).reshape(-1)
