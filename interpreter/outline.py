@@ -18,6 +18,7 @@ import shapely
 from shapely.geometry import Polygon
 from shapely.validation import make_valid
 
+from .geometry.cyclic import following, preceding
 from .geometry.earclip import signed_area as ring_area
 
 CLEAN_TOL = 1e-3  # metres: a corner this close to the previous one or to a straight line goes
@@ -67,7 +68,7 @@ def clean_ring(ring) -> tuple[np.ndarray, str | None]:
 
 def lengths(pts: np.ndarray) -> np.ndarray:
     """The length of each edge of a closed ring (edge i runs from corner i to corner i + 1)."""
-    return np.linalg.norm(np.roll(pts, -1, axis=0) - pts, axis=1)
+    return np.linalg.norm(following(pts) - pts, axis=1)
 
 
 def drop_repeats(pts: np.ndarray) -> np.ndarray:
@@ -126,7 +127,7 @@ def _round(pts: np.ndarray, idx: np.ndarray) -> np.ndarray | None:
     order unless a neighbour went before it.  A corner both of whose neighbours went is
     measured afterwards, and the round ends below its key."""
     m = len(pts)
-    key = _keys(pts, np.roll(pts, 1, axis=0), np.roll(pts, -1, axis=0))
+    key = _keys(pts, preceding(pts), following(pts))
     straight = np.flatnonzero(key < math.inf)
     if not len(straight):
         return straight
@@ -177,7 +178,7 @@ class _Ring:
         n = len(pts)
         self.xy, self.count, self.shift = pts.tolist(), n, max(n.bit_length(), 1)
         self.before, self.after = [n - 1, *range(n - 1)], [*range(1, n), 0]
-        key = _keys(pts, np.roll(pts, 1, axis=0), np.roll(pts, -1, axis=0))
+        key = _keys(pts, preceding(pts), following(pts))
         bits = key.view(np.int64).tolist()
         self.entry: list[int | None] = [
             (b << self.shift) | i if k < math.inf else None

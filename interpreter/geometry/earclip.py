@@ -13,11 +13,13 @@ from __future__ import annotations
 
 import numpy as np
 
+from .cyclic import following, preceding
+
 
 def signed_area(points: np.ndarray) -> float:
     """Shoelace area, positive for a counter-clockwise polygon."""
     p = np.asarray(points, dtype=np.float64)
-    q = np.roll(p, -1, axis=0)
+    q = following(p)
     return 0.5 * float(np.sum(p[:, 0] * q[:, 1] - q[:, 0] * p[:, 1]))
 
 
@@ -64,8 +66,8 @@ def _find_ear(poly: np.ndarray, eps: float) -> int:
     one whose closed triangle contains no other vertex is taken.  Should floating-point trouble
     leave no such ear, the most convex vertex is clipped so that the loop always ends.
     """
-    prev = np.roll(poly, 1, axis=0)
-    nxt = np.roll(poly, -1, axis=0)
+    prev = preceding(poly)
+    nxt = following(poly)
     turn = _cross(poly - prev, nxt - poly)
     convex = np.flatnonzero(turn > eps)
     m = len(poly)

@@ -58,6 +58,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .cyclic import following
 from .earclip import signed_area
 
 TOL = 1e-9  # event and touch tolerance, relative to the polygon's size
@@ -160,7 +161,7 @@ def offset_outward(polygon, distance: float, weights=None):
 def edge_lines(pts: np.ndarray):
     """Unit directions d, inward (left, for a counter-clockwise polygon) unit normals n and
     offsets c of the polygon's edges: edge k lies on the line n[k] . x = c[k]."""
-    d = np.roll(pts, -1, axis=0) - pts
+    d = following(pts) - pts
     d /= np.linalg.norm(d, axis=1)[:, None]
     nrm = np.column_stack([-d[:, 1], d[:, 0]])
     return d, nrm, np.einsum("ij,ij->i", nrm, pts)
@@ -426,13 +427,13 @@ def _area(poly) -> float:
 
 def _perimeter(poly) -> float:
     p = _positions(poly)
-    return float(np.linalg.norm(np.roll(p, -1, axis=0) - p, axis=1).sum())
+    return float(np.linalg.norm(following(p) - p, axis=1).sum())
 
 
 def _short_edge(poly, tol: float):
     """Index of the shortest edge if it is shorter than ``tol``."""
     p = _positions(poly)
-    lengths = np.linalg.norm(np.roll(p, -1, axis=0) - p, axis=1)
+    lengths = np.linalg.norm(following(p) - p, axis=1)
     j = int(np.argmin(lengths))
     return j if lengths[j] < tol else None
 
@@ -447,7 +448,7 @@ def _touch(poly, tol: float):
     """(i, j) of the vertex i closest to a non-adjacent edge j, if closer than ``tol``."""
     p = _positions(poly)
     m = len(p)
-    a, b = p, np.roll(p, -1, axis=0)
+    a, b = p, following(p)
     ab = b - a
     len2 = np.maximum(np.einsum("ij,ij->i", ab, ab), 1e-300)
     rel = p[:, None, :] - a[None, :, :]  # (vertex i, edge j, 2)

@@ -7,12 +7,14 @@ from __future__ import annotations
 import statistics
 import sys
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from bgr.grammar.errors import BgrError, Diagnostic, terminal_text
 
-from .facade import FacadeParse, parse_facade
+if TYPE_CHECKING:  # the parser pulls in scipy.ndimage: every bgr command's start paid for it
+    from .facade import FacadeParse
 
 # the CMP palette's first colours, so that a label map opens in any viewer as CMP's do
 PALETTE = [0, 0, 0, 0, 0, 170, 0, 0, 255, 0, 85, 255, 0, 170, 255]
@@ -182,6 +184,8 @@ def run_facade(args) -> int:
     from .windows import window_style
 
     photo = read_photo(args.input)
+    from .facade import parse_facade
+
     parse = parse_facade(photo)
     window, _ = window_style(photo, parse.windows)
     rule, values, proba = facade_style(parse, photo, args.floor_height)
