@@ -22,6 +22,7 @@ import pytest
 import trimesh
 
 import bgr
+from bgr.formats.glb_read import load, named_meshes
 from bgr.interpreter import outline
 from bgr.interpreter.lots import read_geojson
 from bgr.interpreter.outline import CLEAN_TOL, clean_ring, drop_repeats, drop_straight
@@ -209,8 +210,9 @@ def test_100000_one_triangle_objects_infer_in_30_s(tmp_path):
     took = time.perf_counter() - start
     assert done.returncode == 0, done.stderr
     types = int(re.search(r"100000 objects, 100000 components, (\d) types", done.stderr)[1])
-    meshes = trimesh.load(tmp_path / "city.assets" / "meshes.glb", force="scene")
-    assert len(meshes.graph.nodes_geometry) == types
+    # meshopt-compressed (trimesh does not read it): bgr's reader
+    meshes = named_meshes(*load(tmp_path / "city.assets" / "meshes.glb"))
+    assert len(meshes) == types
     assert "\nCity -->\n    [ t(" in (tmp_path / "city.bgr").read_text()
     assert took < 30.0, f"{took:.1f} s"
 
