@@ -190,6 +190,11 @@ def build_seeds(tmp: Path) -> dict[str, list[Seed]]:
                 seeds[surface].append(_external_bin(files[main_name]))
     mesh = _obj_mesh(BOX_OBJ)
     seeds["glb"].append(Seed("glb", "trimesh.glb", mesh.export(file_type="glb"), {}))
+    # bgr infer's own assets file: meshopt-compressed views, 16-bit quantized positions
+    from bgr.inverse.city.container import Mesh, pack
+
+    packed = pack([Mesh("box", mesh.vertices, mesh.faces)], compress=True)
+    seeds["glb"].append(Seed("glb", "meshopt.glb", packed, {}))
     for name, count in (("3dbag_multi_lod.city.json", 4), ("zurich_lod2.city.json", 3)):
         if (SHARED / name).is_file():
             data = _cityjson_slice(SHARED / name, count)

@@ -282,3 +282,36 @@ def test_position_bounds_are_the_decoded_values(tmp_path):
         acc = gltf["accessors"][index]
         assert values.min(axis=0).tolist() == [np.float32(v) for v in acc["min"]]
         assert values.max(axis=0).tolist() == [np.float32(v) for v in acc["max"]]
+
+
+@pytest.mark.parametrize(
+    ("ctype", "normalized", "scale"), [(5122, True, 32767.0), (5121, False, 1.0)]
+)
+def test_quantized_positions_are_read_only_where_the_file_says_so(
+    tmp_path, ctype, normalized, scale
+):
+    """KHR_mesh_quantization: integer positions (normalized ones mapped to [-1, 1] as glTF
+    states, then the node's scale); without the extension in extensionsUsed, an error that says
+    what is missing."""
+    from test_gltf_hostile import INDICES, box, glb
+
+    doc, _ = box()
+    cells = np.array([[x, y, z] for x in (0, 10) for y in (0, 8) for z in (0, 12)])
+    width = 2 if ctype == 5122 else 1
+    rows = np.column_stack([cells, np.zeros(8, int)]).astype("<i2" if width == 2 else "u1")
+    pos = rows.tobytes()
+    doc["bufferViews"][0] |= {"byteLength": len(pos), "byteStride": 4 * width}
+    doc["bufferViews"][1] |= {"byteOffset": len(pos)}
+    doc["buffers"][0]["byteLength"] = len(pos) + INDICES.nbytes
+    doc["accessors"][0] |= {"componentType": ctype, "normalized": normalized}
+    doc["nodes"][0]["scale"] = [scale] * 3
+    path = tmp_path / "q.glb"
+    path.write_bytes(glb(doc, pos + INDICES.tobytes()))
+    with pytest.raises(BgrError, match="KHR_mesh_quantization"):
+        named_meshes(*load(path))
+    doc["extensionsUsed"] = ["KHR_mesh_quantization"]
+    path.write_bytes(glb(doc, pos + INDICES.tobytes()))
+    vertices, faces = named_meshes(*load(path))["house"]
+    assert len(faces) == 12
+    np.testing.assert_allclose(vertices.min(axis=0), [0, 0, 0], atol=1e-9)
+    np.testing.assert_allclose(vertices.max(axis=0), [10, 8, 12], atol=1e-9)
