@@ -6,8 +6,9 @@ another, a *fallback* buffer that may hold no data at all.  :func:`decoded` fill
 by decoding every compressed view (meshoptimizer's ``meshopt`` binding), so the rest of the
 reader sees plain buffers.  Nothing in the file is believed first: the extension's buffer, range,
 stride, count, mode and filter are checked against the specification and the buffers' real sizes,
-the decoded bytes are bounded (MAX_DECODED) before any is allocated, and a code the decoder
-refuses is a located error, not a crash.
+the decoded bytes are bounded before any is allocated (MAX_DECODED in all, MOST_RATIO times a
+view's codes, a fallback buffer no larger than its views), and a code the decoder refuses is a
+located error, not a crash.
 """
 
 from __future__ import annotations
@@ -20,6 +21,8 @@ MESHOPT = "EXT_meshopt_compression"
 MODES = ("ATTRIBUTES", "TRIANGLES", "INDICES")
 FILTERS = ("NONE", "OCTAHEDRAL", "QUATERNION", "EXPONENTIAL")
 MAX_DECODED = 1 << 30  # bytes of decoded views one file may ask for
+MOST_RATIO = 1024  # decoded bytes a byte of meshopt's codes may stand for (real files: 2 to 20)
+SLACK = 1 << 16  # bytes any view may decode to, however short its codes
 
 
 def compressed(gltf: dict) -> bool:
@@ -59,6 +62,12 @@ def decoded(gltf: dict, blobs: list[bytes]) -> list[bytes]:
     out = [bytearray(b) for b in blobs]
     for k in {job[0] for job in jobs}:
         if len(out[k]) < sizes[k]:  # a fallback buffer: room for the decoded views
+            needed = max(job[1] + job[2] * job[3] for job in jobs if job[0] == k)
+            if sizes[k] > needed + 64:  # 64: alignment padding; not gigabytes of nothing
+                fail(
+                    f"buffer {k}",
+                    f"byteLength {sizes[k]} is more than its compressed views fill ({needed})",
+                )
             out[k] += bytes(sizes[k] - len(out[k]))
     for target, start, count, stride, mode, filt, code, v in jobs:
         out[target][start : start + count * stride] = _decode(code, count, stride, mode, filt, v)
@@ -84,6 +93,8 @@ def _checked(
         fail(name, f"filter {_shown(filt)} is not one of {', '.join(FILTERS)}")
     if count * stride != length:
         fail(name, f"count {count} x byteStride {stride} is not its view's byteLength {length}")
+    if length > MOST_RATIO * code_length + SLACK:  # refused before anything is allocated
+        fail(name, f"{code_length} bytes of codes cannot hold the {length} bytes it claims")
     if "byteStride" in view and view["byteStride"] != stride:
         fail(name, f"byteStride {stride} is not its view's {view['byteStride']!r:.40}")
     if mode == "ATTRIBUTES" and stride % 4:

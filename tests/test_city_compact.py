@@ -118,6 +118,7 @@ def test_compressed_assets_are_valid_and_an_independent_reader_agrees(validator,
         ("count", 7),
         ("byteStride", 3),
         ("byteLength", 10**9),
+        ("count", 3 * 10**7),
         ("buffer", 5),
     ],
 )
@@ -315,3 +316,31 @@ def test_quantized_positions_are_read_only_where_the_file_says_so(
     assert len(faces) == 12
     np.testing.assert_allclose(vertices.min(axis=0), [0, 0, 0], atol=1e-9)
     np.testing.assert_allclose(vertices.max(axis=0), [10, 8, 12], atol=1e-9)
+
+
+def test_a_tiny_file_cannot_claim_gigabytes_of_decoded_data(tmp_path):
+    """A view whose count and byteLength agree but are far beyond what its codes can hold, and
+    a fallback buffer that claims far more than its views: refused before any allocation."""
+    data = pack(meshes(), compress=True, step=STEP, coarsest=0.0025)
+    length = struct.unpack("<I", data[12:16])[0]
+
+    def saved(head: dict) -> object:
+        text = json.dumps(head).encode()
+        text += b" " * (-len(text) % 4)
+        body = struct.pack("<II", len(text), 0x4E4F534A) + text + data[20 + length :]
+        path = tmp_path / "big.glb"
+        path.write_bytes(struct.pack("<III", 0x46546C67, 2, 12 + len(body)) + body)
+        return path
+
+    head = json.loads(data[20 : 20 + length])
+    view = head["bufferViews"][-1]
+    ext = view["extensions"]["EXT_meshopt_compression"]
+    ext["count"] = 50_000_000
+    view["byteLength"] = ext["count"] * ext["byteStride"]
+    head["buffers"][1]["byteLength"] = view.get("byteOffset", 0) + view["byteLength"]
+    with pytest.raises(BgrError, match="cannot hold"):
+        named_meshes(*load(saved(head)))
+    head = json.loads(data[20 : 20 + length])
+    head["buffers"][1]["byteLength"] = 1 << 31
+    with pytest.raises(BgrError, match="more than its compressed views fill"):
+        named_meshes(*load(saved(head)))
