@@ -189,6 +189,7 @@ class _Spool:
     def __init__(self, folder: str | None, memory: int = SPOOL_MEMORY) -> None:
         # closed by close(): a spool lives as long as the Scene that owns it
         self.file = tempfile.SpooledTemporaryFile(max_size=memory, dir=folder)  # noqa: SIM115
+        self.memory = memory
         self.count = 0
         self.nbytes = 0
 
@@ -201,8 +202,11 @@ class _Spool:
         self.nbytes += len(text)
 
     def raw(self, data) -> None:
+        size = len(memoryview(data).cast("B"))
+        if self.nbytes + size > self.memory:  # straight to disk: not a second copy in memory
+            self.file.rollover()
         self.file.write(data)
-        self.nbytes += len(memoryview(data).cast("B"))
+        self.nbytes += size
 
     def copy_to(self, stream: BinaryIO) -> None:
         self.file.seek(0)

@@ -211,6 +211,9 @@ def shape_order(
     return rows[np.lexsort((rows, shape, major))]
 
 
+CHUNK_TRIANGLES = 1 << 17  # triangles placed at a time: bounds place_corners' temporaries
+
+
 def place_corners(
     table: TerminalTable,
     rows: np.ndarray,
@@ -231,51 +234,62 @@ def place_corners(
     rows = np.asarray(rows, dtype=np.int64)
     mesh = table.mesh[rows].astype(np.int64)
     fstart = face_offsets(table, rows, pool)
-    origin = table.origin[rows] if shift is None else table.origin[rows] - shift
-    origin, axes, size = (
-        origin.astype(f32),
-        table.axes[rows].astype(f32),
-        table.size[rows].astype(f32),
-    )
-    flip = mirrored(table, rows)
     vpool = pool.vertices.astype(f32)
+
+    def columns(at: np.ndarray) -> tuple[np.ndarray, ...]:
+        """float32 origin (less ``shift``), axes and size of the rows ``at``, and their flips."""
+        origin = table.origin[at] if shift is None else table.origin[at] - shift
+        return (
+            origin.astype(f32),
+            table.axes[at].astype(f32),
+            table.size[at].astype(f32),
+            mirrored(table, at),
+        )
+
+    # a lot's few thousand rows gathered once; a whole city's a chunk at a time, so that the
+    # temporaries stay a few MB (grid_city n = 40: 1,253 -> 954 MB peak with its GLB)
+    gathered = columns(rows) if len(rows) <= CHUNK_TRIANGLES // 8 else None
 
     def corners(sel: np.ndarray, F: int, out: np.ndarray) -> None:
         """World corners of the rows ``sel`` (one shape, F faces each) into out (len(sel) * F, 3,
-        3).
-        """
+        3)."""
+        if gathered is None:
+            origin, axes, size, flip = columns(rows[sel])
+        else:
+            origin, axes, size, flip = (column[sel] for column in gathered)
         m = mesh[sel]
         if m[0] == m[-1] and (m == m[0]).all():  # one shared unit mesh
             lo = pool.foff[m[0]]
             unit = vpool[pool.faces[lo : lo + F].reshape(-1) + pool.voff[m[0]]]
-            local = unit[None] * size[sel][:, None, :]
+            local = unit[None] * size[:, None, :]
         else:
             idx = pool.faces[pool.foff[m][:, None] + np.arange(F)] + pool.voff[m][:, None, None]
-            local = vpool[idx.reshape(len(sel), 3 * F)] * size[sel][:, None, :]
+            local = vpool[idx.reshape(len(sel), 3 * F)] * size[:, None, :]
         world = out.reshape(len(sel), 3 * F, 3)
-        np.matmul(local, axes[sel], out=world)
-        world += origin[sel][:, None, :]
-        flipped = flip[sel]
-        if flipped.any():
+        np.matmul(local, axes, out=world)
+        world += origin[:, None, :]
+        if flip.any():
             tri = world.reshape(len(sel), F, 3, 3)
-            tri[flipped] = tri[flipped][:, :, [0, 2, 1]]
+            tri[flip] = tri[flip][:, :, [0, 2, 1]]
 
-    for group in _shape_groups(pool.vcount[mesh], pool.fcount[mesh]):
-        F = int(pool.fcount[mesh[group[0]]])
+    for whole in _shape_groups(pool.vcount[mesh], pool.fcount[mesh]):
+        F = int(pool.fcount[mesh[whole[0]]])
         if F == 0:
             continue
-        runs = np.split(group, np.flatnonzero(np.diff(group) != 1) + 1)
-        if len(runs) <= max(16, len(group) // 256):  # long runs: write each in place
-            for run in runs:
-                lo, hi = fstart[run[0]], fstart[run[-1] + 1]
-                corners(run, F, positions[lo:hi])
-                normals[lo:hi] = unit_normals(positions[lo:hi])[:, None, :]
-        else:  # scattered rows: compute the group, then scatter its triangles
-            tri = np.empty((len(group) * F, 3, 3), dtype=f32)
-            corners(group, F, tri)
-            at = (fstart[group][:, None] + np.arange(F)).reshape(-1)
-            positions[at] = tri
-            normals[at] = unit_normals(tri)[:, None, :]
+        step = max(1, CHUNK_TRIANGLES // F)  # temporaries a few MB, not the size of the file
+        for group in (whole[i : i + step] for i in range(0, len(whole), step)):
+            runs = np.split(group, np.flatnonzero(np.diff(group) != 1) + 1)
+            if len(runs) <= max(16, len(group) // 256):  # long runs: write each in place
+                for run in runs:
+                    lo, hi = fstart[run[0]], fstart[run[-1] + 1]
+                    corners(run, F, positions[lo:hi])
+                    normals[lo:hi] = unit_normals(positions[lo:hi])[:, None, :]
+            else:  # scattered rows: compute the group, then scatter its triangles
+                tri = np.empty((len(group) * F, 3, 3), dtype=f32)
+                corners(group, F, tri)
+                at = (fstart[group][:, None] + np.arange(F)).reshape(-1)
+                positions[at] = tri
+                normals[at] = unit_normals(tri)[:, None, :]
 
 
 def srgb8(table: TerminalTable) -> np.ndarray:
