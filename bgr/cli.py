@@ -130,8 +130,10 @@ def build_parser() -> argparse.ArgumentParser:
         type=_count,
         default=1,
         metavar="N",
-        help="derive lots on N local processes (0: one per core; default 1, this process); the "
-        "files are the same bytes whatever N",
+        help="derive lots on N local processes (0: one per core; default 1, this process, "
+        "which then streams a lot file's GLB, CityJSON Sequence or JSON through a second "
+        "process that writes it, when there is a second core); the files are the same bytes "
+        "whatever N",
     )
     parallel.add_argument(
         "--dask",
@@ -707,12 +709,9 @@ def _count(text: str) -> int:
 
 
 def cmd_derive(args) -> int:
-    import numpy as np
-
-    from .formats.sinks import open_sink, streams
-    from .interpreter.batch import default_workers, derive_lots
-    from .interpreter.derive import FeatureOrder, prepare, site_of
-    from .interpreter.lots import check_mapping
+    from .formats.background import background, worth_it
+    from .interpreter.batch import default_workers
+    from .interpreter.lots import names_a_file
 
     if args.output in (None, "-") and args.format != "json":
         print(
@@ -736,11 +735,28 @@ def cmd_derive(args) -> int:
     if isinstance(limits, str):
         print(f"bgr derive: {limits}", file=sys.stderr)
         return EXIT_USAGE
-    workers = args.workers or default_workers()
-    grammar = load(Path(args.file), path=args.file, allow_paths=args.allow_path)
-    check_mapping(options, grammar.attrs, args.file)
     output = "-" if args.output in (None, "-") else args.output
     fmt = args.format if output != "-" else "json"
+    workers = args.workers or default_workers()
+    # lots from a file, streamed to a file: written by a second process while this one derives
+    # (formats.background); one lot is not worth a process
+    many = args.lot is not None and names_a_file(args.lot)
+    wanted = many and not args.dask and worth_it(output, fmt, args.group_by, workers)
+    with background(wanted) as writer:
+        return _derive(args, attrs, options, limits, workers, output, fmt, writer)
+
+
+def _derive(args, attrs, options, limits, workers, output, fmt, writer) -> int:
+    """cmd_derive once its arguments are checked: load, derive lot by lot, write."""
+    import numpy as np
+
+    from .formats.sinks import open_sink, streams
+    from .interpreter.batch import derive_lots
+    from .interpreter.derive import FeatureOrder, prepare, site_of
+    from .interpreter.lots import check_mapping
+
+    grammar = load(Path(args.file), path=args.file, allow_paths=args.allow_path)
+    check_mapping(options, grammar.attrs, args.file)
     job, lots, warnings = prepare(
         grammar,
         seed=args.seed,
@@ -763,7 +779,7 @@ def cmd_derive(args) -> int:
 
     read = FeatureOrder(warnings)  # the lot file's warnings, among the lots' in feature order
     with (
-        open_sink(
+        (writer.open_sink if writer is not None else open_sink)(
             output,
             seed=args.seed,
             attrs=job.values,

@@ -264,13 +264,20 @@ def footprint(
 _BY = re.compile(r"\s*([0-9.][0-9.eE+-]*)\s*[xX]\s*([0-9.][0-9.eE+-]*)\s*")
 
 
+def names_a_file(value: str) -> bool:
+    """Whether a ``--lot`` value names a GeoJSON file (many lots) rather than W,D or WxD."""
+    return not (
+        _BY.fullmatch(value) or ("," in value and not value.lower().endswith((".json", ".geojson")))
+    )
+
+
 def parse_lot_option(
     value: str, warnings: Warnings | None = None, options: LotOptions | None = None
 ) -> list[Lot]:
     """``W,D`` (or ``WxD``) or a GeoJSON file of footprints, read with ``options`` (a W x D lot
     takes none).  A value that spells two numbers is always a rectangle, never a file."""
     by = _BY.fullmatch(value)
-    if by or ("," in value and not value.lower().endswith((".json", ".geojson"))):
+    if not names_a_file(value):
         parts = [by[1], by[2]] if by else value.split(",")
         sides = [number_of(v) for v in parts]  # ASCII numbers only, as in .bgr
         if len(sides) != 2 or sides[0] is None or sides[1] is None:  # "nan", "1_0", "1e400"
