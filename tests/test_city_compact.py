@@ -9,6 +9,7 @@ import json
 import shutil
 import struct
 import subprocess
+import sys
 
 import numpy as np
 import pytest
@@ -344,3 +345,87 @@ def test_a_tiny_file_cannot_claim_gigabytes_of_decoded_data(tmp_path):
     head["buffers"][1]["byteLength"] = 1 << 31
     with pytest.raises(BgrError, match="more than its compressed views fill"):
         named_meshes(*load(saved(head)))
+
+
+# ---- surfaces of a format without types --------------------------------------------------------
+
+
+def write_obj(path, named: list[tuple[str, trimesh.Trimesh]]) -> None:
+    """An OBJ of named objects, z up as GIS exports are (bgr's y up turned: (x, y, z) ->
+    (x, -z, y))."""
+    lines, base = [], 1
+    for name, mesh in named:
+        lines.append(f"o {name}")
+        lines += [f"v {x:.3f} {-z:.3f} {y:.3f}" for x, y, z in mesh.vertices]
+        lines += [f"f {a + base} {b + base} {c + base}" for a, b, c in mesh.faces]
+        base += len(mesh.vertices)
+    path.write_text("\n".join(lines) + "\n")
+
+
+def test_objects_without_walls_in_an_obj_are_carried_as_surfaces(tmp_path):
+    """An OBJ says nothing of types: its roads and terrain (faces no steeper than 60 degrees on
+    all but 5 % of their area) are carried like CityJSON's, one mesh for all, and its
+    buildings are proceduralized."""
+    from bgr.inverse.city.read import read_city
+
+    ground = terrain(60.0, 6)
+    ground.apply_translation([-10, -1, -10])
+    road = box(0, 0, 20, 40, 0.0, 24)  # a flat slab: top and bottom, walls of no area
+    road = trimesh.Trimesh(road.vertices, road.faces[road.area_faces > 0])
+    named = [
+        ("house", gable_house(8, 10, 6)),
+        ("ground", ground),
+        ("road", road),
+        ("block", box(20, 0, 0, 30, 9, 12)),
+    ]
+    obj = tmp_path / "city.obj"
+    write_obj(obj, named)
+    city = read_city(obj)
+    kinds = {o.name: (o.kind, o.proceduralize) for o in city.objects}
+    assert kinds == {
+        "house": ("object", True),
+        "ground": ("surface", False),
+        "road": ("surface", False),
+        "block": ("object", True),
+    }
+    proc = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "bgr",
+            "infer",
+            str(obj),
+            "--no-progress",
+            "-o",
+            str(tmp_path / "out.bgr"),
+        ],
+        capture_output=True,
+        text=True,
+    )
+    assert proc.returncode == 0, proc.stderr
+    assert "surface: 2 objects, carried as they are" in (tmp_path / "out.bgr").read_text()
+    data = (tmp_path / "out.assets" / "meshes.glb").read_bytes()
+    head = json.loads(data[20 : 20 + struct.unpack("<I", data[12:16])[0]])
+    carried = [n["extras"]["objects"] for n in head["nodes"] if "extras" in n]
+    assert [[name for name, _ in objects] for objects in carried] == [["ground", "road"]]
+    # and level 0 still derives every triangle back where it was
+    out = tmp_path / "out.obj"
+    proc = subprocess.run(
+        [sys.executable, "-m", "bgr", "derive", str(tmp_path / "out.bgr"), "-o", str(out)],
+        capture_output=True,
+        text=True,
+    )
+    assert proc.returncode == 0, proc.stderr
+    built = trimesh.load(out, force="mesh", process=False)
+    source = trimesh.load(obj, force="mesh", process=False)  # z up, as the file: no offset
+    assert len(built.faces) == len(source.faces)
+    _, gap, _ = trimesh.proximity.closest_point(source, built.vertices)
+    assert gap.max() < 0.01
+
+
+def test_a_file_of_nothing_but_surfaces_is_proceduralized(tmp_path):
+    from bgr.inverse.city.read import read_city
+
+    obj = tmp_path / "flat.obj"
+    write_obj(obj, [("a", terrain(30.0, 3)), ("b", box(40, 0, 0, 50, 0, 10))])
+    assert all(o.proceduralize and o.kind == "object" for o in read_city(obj).objects)

@@ -393,7 +393,13 @@ def test_delft_obj_is_570_objects_z_up():
     assert len(scene.objects) == 570 and scene.triangles == 36271
     assert scene.up == "z" and abs(scene.offset[0] - 85000) < 1000
     assert scene.offset[1] == pytest.approx(447000, abs=1000)
-    assert all(o.proceduralize for o in scene.objects)
+    # its roads, land use and water have no walls: 218 surfaces, carried (no building among
+    # them: the CityJSON of the same tile types them)
+    surfaces = [o for o in scene.objects if o.kind == "surface"]
+    assert len(surfaces) == 218 and not any(o.proceduralize for o in surfaces)
+    typed = {o.name: o.kind for o in read_city(shared("delft.city.json")).objects}
+    assert not any(typed.get(o.name) == "Building" for o in surfaces)
+    assert sum(typed.get(o.name) == "Building" for o in scene.objects) == 160
 
 
 # --- CityJSON ------------------------------------------------------------------------------------

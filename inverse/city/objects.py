@@ -127,3 +127,34 @@ def separate(
         new_index[part] = len(out)
         out.append(piece)
     return new_index[label], out
+
+
+STEEP = 0.5  # |normal . up| below this (steeper than 60 degrees): a face is a wall
+WALL_SHARE = 0.05  # an object with walls on less than this share of its area is a surface
+
+
+def mark_surfaces(
+    vertices: np.ndarray, faces: np.ndarray, owner: np.ndarray, objects: list[CityObject]
+) -> None:
+    """Objects of a format without types (OBJ, PLY, glTF) that have next to no walls — roads,
+    terrain, water, land use, a roof without its walls — are surfaces: carried through as they
+    are (kind ``surface``, one mesh for all of them), not proceduralized as buildings, as
+    CityJSON's roads and land use are by their type.  Walls are faces steeper than 60 degrees;
+    under WALL_SHARE of an object's area, it has none to speak of.  When every object would be a
+    surface, none is: the file is then what there is to proceduralize."""
+    tri = vertices[faces]
+    normal = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
+    area = np.linalg.norm(normal, axis=1)
+    steep = np.abs(normal[:, 1]) < STEEP * area  # bgr's frame: y is up
+    total = np.bincount(owner, area, minlength=len(objects))
+    walls = np.bincount(owner, np.where(steep, area, 0.0), minlength=len(objects))
+    flat = [
+        k
+        for k, obj in enumerate(objects)
+        if obj.kind == "object" and obj.proceduralize and walls[k] < WALL_SHARE * total[k]
+    ]
+    if len(flat) == sum(obj.proceduralize for obj in objects):
+        return
+    for k in flat:
+        objects[k].kind = "surface"
+        objects[k].proceduralize = False

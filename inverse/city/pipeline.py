@@ -430,9 +430,10 @@ def _header(scene: CityScene, comps: list[Component], types: Types, placed: Plac
 def site_of(scene: CityScene) -> n.Site | None:
     """The grammar's ``site`` declaration (grammar/site.py): the input's CRS (as EPSG:NNNN where
     pyproj can name it so), its up axis and the exact offset its coordinates were re-centred
-    by; None for an input in plain local metres."""
+    by; None for an input in plain local metres with y up, bgr's own frame (a z-up input near
+    the origin still needs ``up z`` to come back in its own axes)."""
     crs = crs_name(scene.crs) if scene.crs else None
-    if crs is None and not np.any(scene.offset):
+    if crs is None and not np.any(scene.offset) and scene.up == "y":
         return None
     x, y, z = (float(v) for v in scene.offset)
     return n.Site(crs, (x, y, z), scene.up)

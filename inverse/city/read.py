@@ -33,7 +33,7 @@ from bgr.grammar.paths import read_input
 
 from .coordinates import Locate, check_coordinates
 from .model import CityObject, CityScene
-from .objects import components, separate
+from .objects import components, mark_surfaces, separate
 
 if TYPE_CHECKING:
     import trimesh
@@ -196,6 +196,7 @@ def _scene(shown: str, found: Found, up: str) -> CityScene:
         owner, count = components(local, faces)
         objects = [_template(f"object-{k}") for k in range(1, count + 1)]
     else:
+        mark_surfaces(local, faces, owner, objects)  # roads and terrain of a typeless format
         owner, objects = separate(local, faces, owner, objects)
     scene.objects = _split(local, faces, colors, owner, objects)
     return scene
