@@ -160,6 +160,25 @@ def test_a_coarser_level_has_fewer_types(tmp_path):
     assert len(coarse.placed.terminals) < len(fine.placed.terminals)
 
 
+def test_a_lossy_level_writes_lengths_no_finer_than_it_moves_things(tmp_path):
+    """Level 0 writes millimetres (a tenth of the 1 cm tolerance); level 3, whose building kinds
+    merge on a 1 m grid, centimetres: the digits it would spend are noise."""
+    scene = street(3)
+    for i, obj in enumerate(scene.objects):
+        obj.vertices = obj.vertices * np.array([1 + 0.01 * i, 1, 1]) + 0.0123
+
+    def decimals(text: str) -> int:
+        lengths = re.findall(r"\b(?:t|s|polygon|extrude)\(([^)]*)\)", text)
+        return max(len(d) for args in lengths for d in re.findall(r"\d\.(\d+)", args))
+
+    _, fine = infer_scene(scene, tmp_path)
+    _, coarse = infer_scene(scene, tmp_path, level=3)
+    assert decimals(fine) == 3 and decimals(coarse) == 2
+    from bgr.inverse.city.tree import level_digits
+
+    assert [level_digits(level) for level in range(1, 9)] == [3, 3, 2, 2, 2, 2, 1, 1]
+
+
 # ---- editing ----------------------------------------------------------------------------------
 
 

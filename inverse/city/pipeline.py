@@ -374,6 +374,8 @@ def build(
 ) -> CityGrammar:
     named = []
     digits = digits_for(options.tolerance)
+    if placed.level.index > 0:  # a lossy level: lengths no finer than it moves things
+        digits = min(digits, tree.level_digits(placed.level.index))
     with _bar(options, len(placed.terminals) + len(placed.carried), "writing meshes") as bar:
         for t, rep in zip(placed.terminals, placed.term_mesh, strict=True):
             if t.prism is None:  # a footprint extruded is written as operations, not a mesh
