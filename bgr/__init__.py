@@ -18,6 +18,7 @@ from importlib import import_module
 from typing import TYPE_CHECKING, Any
 
 if TYPE_CHECKING:
+    from .grammar.annotations import attr_metadata
     from .grammar.checker import Grammar
     from .grammar.errors import BgrCheckError, BgrError, BgrSyntaxError, Diagnostic
     from .grammar.formatter import format_module, format_source
@@ -28,6 +29,7 @@ if TYPE_CHECKING:
 # The API is imported when first used, not with the package: ``bgr --version`` and a command
 # that needs only the parser start without the interpreter, numpy and trimesh (issue 30).
 _WHERE = {
+    "attr_metadata": ".grammar.annotations",
     "Grammar": ".grammar.checker",
     "BgrError": ".grammar.errors",
     "BgrCheckError": ".grammar.errors",
@@ -69,6 +71,7 @@ def __getattr__(name: str) -> Any:
 
 
 __all__ = [
+    "attr_metadata",
     "load",
     "derive",
     "Result",

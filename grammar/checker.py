@@ -13,6 +13,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from . import nodes as n
+from .annotations import annotation_errors
 from .errors import Diagnostic, source_line, suggest
 from .formatter import format_params
 from .limits import MAX_NESTING, children, expr_depth, expressions
@@ -149,6 +150,7 @@ class Checker:
                 self.rule(item)
         self.value_cycles()
         self.call_nesting()
+        self.diagnostics += annotation_errors(self.g.path, self.g.module)
         return self.diagnostics
 
     # ---- declarations ---------------------------------------------------------------------

@@ -156,6 +156,13 @@ def _is_signed(e) -> bool:
     )
 
 
+def format_annotation(note: n.Annotation) -> str:
+    """``@Name`` or ``@Name(args)``, arguments as a call's (``min = 1``)."""
+    if not note.args:
+        return f"@{note.name}"
+    return f"@{note.name}({', '.join(format_arg(a) for a in note.args)})"
+
+
 def format_arg(a) -> str:
     if isinstance(a, n.Keyword):
         return f"{a.name} = {format_expr(a.value)}"
@@ -248,7 +255,11 @@ class Formatter:
     def format(self) -> str:
         out = _Writer()
         for item in self.module.items:
-            out.start(item.pos.line, 0, top=True)
+            notes = getattr(item, "annotations", None) or []
+            out.start(notes[0].pos.line if notes else item.pos.line, 0, top=True)
+            for k, note in enumerate(notes):  # one a line, above what they annotate
+                out.write(format_annotation(note))
+                out.start(notes[k + 1].pos.line if k + 1 < len(notes) else item.pos.line, 0)
             if isinstance(item, n.Rule):
                 self.rule(item, out)
             else:

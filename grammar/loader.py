@@ -12,6 +12,7 @@ from collections.abc import Iterable
 from pathlib import Path
 
 from . import nodes as n
+from .annotations import annotation_warnings
 from .checker import Checker, Grammar
 from .errors import BgrCheckError, BgrError, BgrSyntaxError, Diagnostic, source_line, suggest
 from .parser import parse
@@ -250,8 +251,10 @@ def load(
         raise (BgrSyntaxError if grammar is None else BgrCheckError)(ordered)
     assert grammar is not None
     # warnings: each file's own (an import's once, in the order the files were loaded)
-    for module in [*loader.done.values(), grammar]:
+    modules = {id(m): m for m in [*loader.done.values(), grammar]}  # the file itself once
+    for module in modules.values():
         grammar.warnings += unproductive_cycles(module)
+        grammar.warnings += annotation_warnings(module.path, module.module)
     return grammar
 
 

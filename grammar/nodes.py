@@ -239,6 +239,7 @@ class Rule:
     pos: Pos = _pos()
     param_pos: list[Pos] = field(default_factory=list, compare=False, repr=False, kw_only=True)
     defaults: list = field(default_factory=list, kw_only=True)
+    annotations: list[Annotation] = field(default_factory=list, kw_only=True)
 
     def default(self, i: int):
         """The default expression of parameter ``i``, or None when it has none."""
@@ -269,6 +270,17 @@ class Import:
 class Attr:
     name: str
     value: Expr
+    pos: Pos = _pos()
+    annotations: list[Annotation] = field(default_factory=list, kw_only=True)
+
+
+@dataclass
+class Annotation:
+    """``@Name`` or ``@Name(args)`` before an attr or a rule (CGA's annotations): metadata for
+    editors, checked by grammar/annotations.py; ``args`` holds expressions and Keywords."""
+
+    name: str
+    args: list = field(default_factory=list)
     pos: Pos = _pos()
 
 

@@ -157,7 +157,15 @@ class _TreeBuilder(Transformer):
         return n.Import(str(c[1]), module=str(c[0]), pos=_span(c), alias_pos=_tok_pos(c[1]))
 
     def attr_decl(self, c):
-        return n.Attr(str(c[0]), c[1], pos=_span(c))
+        notes, name, value = c
+        return n.Attr(str(name), value, pos=_span(c[1:]), annotations=notes or [])
+
+    def annotations(self, c):
+        return list(c)
+
+    def annotation(self, c):
+        _at, name, args = c
+        return n.Annotation(str(name), args or [], pos=_span(c))
 
     def const_decl(self, c):
         return n.Const(str(c[0]), c[1], pos=_span(c))
@@ -210,7 +218,7 @@ class _TreeBuilder(Transformer):
 
     # ---- rules ----------------------------------------------------------------------------
     def rule(self, c):
-        name_tok, params, _arrow, body = c
+        notes, name_tok, params, _arrow, body = c
         if str(name_tok) in KEYWORDS:
             raise _Problem(
                 _tok_pos(name_tok),
@@ -222,9 +230,10 @@ class _TreeBuilder(Transformer):
             str(name_tok),
             [str(p) for p, _ in params],
             body,
-            pos=_span(c),
+            pos=_span(c[1:]),  # the rule's own text: its annotations have their own places
             param_pos=[_tok_pos(p) for p, _ in params],
             defaults=[d for _, d in params] if any(d is not None for _, d in params) else [],
+            annotations=notes or [],
         )
 
     def rule_params(self, c):
@@ -600,6 +609,7 @@ def _check_nesting(items: list[n.Item], text: str, path: str) -> None:
 _TERMINAL_WORDS = {
     "NAME": "a name",
     "RULE_NAME": "a rule ('Name --> ...')",
+    "AT": "an annotation ('@Name')",
     "NUMBER": "a number",
     "STRING": 'a string ("...")',
     "ARROW": "'-->'",
@@ -632,6 +642,7 @@ _DECLARATIONS = {
     "TERMINAL",
     "START",
     "RULE_NAME",
+    "AT",
 }
 
 

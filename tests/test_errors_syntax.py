@@ -125,12 +125,12 @@ CASES = [
     ),
     # ---- characters -------------------------------------------------------------------------
     pytest.param(
-        "Lot --> extrude(3) @ A\n",
+        "Lot --> extrude(3) $ A\n",
         1,
         20,
-        "unexpected character '@'",
+        "unexpected character '$'",
         None,
-        id="unknown-character-at",
+        id="unknown-character-dollar",
     ),
     pytest.param("A --> B;\n", 1, 8, "unexpected character ';'", None, id="semicolon"),
     pytest.param("A --> B é\n", 1, 9, "unexpected character 'é'", None, id="non-ascii-character"),
@@ -398,11 +398,11 @@ def test_crlf_line_endings():
 
 
 def test_byte_order_mark_does_not_shift_columns():
-    check(b"\xef\xbb\xbfA --> B @\n", 1, 9, "unexpected character '@'")
+    check(b"\xef\xbb\xbfA --> B $\n", 1, 9, "unexpected character '$'")
 
 
 def test_multibyte_character_counts_one_column():
-    check('A --> color("\u00e9\u00e9") @\n', 1, 19, "unexpected character '@'")
+    check('A --> color("\u00e9\u00e9") $\n', 1, 19, "unexpected character '$'")
 
 
 def test_stray_quote_is_named_readably():
