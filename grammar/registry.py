@@ -411,6 +411,43 @@ BUILTINS: dict[str, Builtin] = {
             "rectangle without holes, every corner within tolerance degrees of a right angle "
             "(default 1), as CGA's function of that name; false for other solids but cubes.",
         ),
+        Builtin(
+            "geometry.area",
+            0,
+            0,
+            "geometry.area()",
+            "the sum of the areas of all the faces of the shape's geometry, in square metres "
+            "(a 10 x 20 m lot: 200; that lot extruded 5 m: 700).",
+        ),
+        Builtin(
+            "geometry.volume",
+            0,
+            0,
+            "geometry.volume()",
+            "the volume the shape's closed geometry encloses, in cubic metres; 0 for a 2D shape.",
+        ),
+        Builtin(
+            "geometry.nVertices",
+            0,
+            0,
+            "geometry.nVertices()",
+            "the distinct corners of the shape's geometry (a box: 8).",
+        ),
+        Builtin(
+            "geometry.nFaces",
+            0,
+            0,
+            "geometry.nFaces()",
+            "the faces of the shape's geometry, coplanar connected triangles counted as one "
+            "polygon (a box: 6).",
+        ),
+        Builtin(
+            "geometry.height",
+            0,
+            0,
+            "geometry.height()",
+            "the extent of the shape's geometry along the world's vertical, in metres.",
+        ),
     ]
 }
 

@@ -464,7 +464,9 @@ class Application:
             local = engine.rule_locals[id(rule)] = frozenset(rule.params)
         self.local = local
         # split.index/total and comp.index/total of the piece this shape came from stay visible
-        self.ctx = Context(shape, args, Stream(shape.hash), engine.seed, indices)
+        self.ctx = Context(
+            shape, args, Stream(shape.hash), engine.seed, indices, engine.table.library
+        )
         self.children: list = []
         self.counter = 0
         if len(args) != len(rule.params):

@@ -53,14 +53,23 @@ class Context:
         "comp_total",
         "comp_left",
         "comp_right",
+        "library",
     )
 
     def __init__(
-        self, shape, args: dict, stream, seed: int, indices=(0, 1, 0, 1, 0.0, 0.0)
+        self,
+        shape,
+        args: dict,
+        stream,
+        seed: int,
+        indices=(0, 1, 0, 1, 0.0, 0.0),
+        library=None,
     ) -> None:
         """``indices``: split.index, split.total, comp.index, comp.total and the comp face's
-        left and right neighbour angles of the piece the shape came from."""
+        left and right neighbour angles of the piece the shape came from; ``library``: the
+        derivation's unit meshes, which the geometry functions measure a mesh shape by."""
         self.shape, self.args, self.stream, self.seed = shape, args, stream, seed
+        self.library = library
         (
             self.split_index,
             self.split_total,
@@ -142,6 +151,12 @@ _MATH = {
     "tan": _deg(math.tan),
     "round": lambda x: math.floor(x + 0.5) if x >= 0 else -math.floor(-x + 0.5),
 }
+
+
+# CGA's geometry functions that measure the shape's geometry (interpreter/geometry/queries.py)
+_GEOMETRY_QUERIES = frozenset(
+    ("geometry.area", "geometry.volume", "geometry.nVertices", "geometry.nFaces", "geometry.height")
+)
 
 
 class Compiler:
@@ -338,6 +353,11 @@ class Compiler:
                 max(_num(module, pos, x(ctx)), _num(module, pos, lo(ctx))),
                 _num(module, pos, hi(ctx)),
             )
+        if name in _GEOMETRY_QUERIES:  # geometry.area() and the others: the shape's geometry
+            from .geometry.queries import QUERIES
+
+            query = QUERIES[name]
+            return lambda ctx: query(ctx.shape, ctx.library)
         if name == "geometry.isRectangular":
             tolerance = args[0] if args else (lambda ctx: 1.0)
             return lambda ctx: is_rectangular(ctx.shape, _num(module, pos, tolerance(ctx)))

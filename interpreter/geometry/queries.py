@@ -1,0 +1,88 @@
+"""CGA's geometry functions: what the current shape's geometry measures, in metres.
+
+``geometry.area()``, ``geometry.volume()``, ``geometry.nVertices()``, ``geometry.nFaces()`` and
+``geometry.height()`` read the shape's own geometry (its outline, its extruded prism, its roof or
+inserted mesh) scaled to its scope, as CityEngine's functions of those names do: the area is the
+sum of all its faces, the volume the one its closed surface encloses (0 for a 2D shape), the
+vertices and faces those of its polygons (a box has 8 and 6, not its triangles' 24 and 12), and
+the height its extent along the world's vertical.  All are pure functions of the geometry, the
+scope's size and its axes, which the reuse keys hold (interpreter/reuse.py), so a subtree that
+asks them is still derived once and replayed.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..shapes import Flat, Prism, Solid
+from .frames import planar_faces
+from .meshes import flat_mesh, prism_mesh
+
+
+def scope_mesh(shape, library) -> tuple[np.ndarray, np.ndarray]:
+    """The shape's triangles in its scope's metres: (V, 3) vertices and (F, 3) faces."""
+    geom = shape.geom
+    size = np.asarray(shape.size, dtype=np.float64)
+    if isinstance(geom, Solid):
+        unit = library.meshes[geom.mesh]
+        return np.asarray(unit.vertices, dtype=np.float64) * size, np.asarray(unit.faces)
+    if isinstance(geom, Flat):
+        verts, faces = flat_mesh(geom.polys, geom.k)
+    elif isinstance(geom, Prism):
+        verts, faces = prism_mesh(geom.polys, geom.k)
+    else:  # pragma: no cover - every shape has one of the three
+        return np.zeros((0, 3)), np.zeros((0, 3), dtype=np.int64)
+    return verts * size, faces
+
+
+def _corners(shape, library) -> np.ndarray:
+    verts, faces = scope_mesh(shape, library)
+    return verts[faces] if len(faces) else np.zeros((0, 3, 3))
+
+
+def area(shape, library) -> float:
+    """The sum of the areas of all the geometry's faces, in square metres."""
+    tri = _corners(shape, library)
+    cross = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
+    return float(0.5 * np.linalg.norm(cross, axis=1).sum())
+
+
+def volume(shape, library) -> float:
+    """The volume the geometry's surface encloses (the divergence theorem over its triangles),
+    in cubic metres; 0 for a 2D shape."""
+    if isinstance(shape.geom, Flat):
+        return 0.0
+    tri = _corners(shape, library)
+    signed = np.einsum("ij,ij->i", tri[:, 0], np.cross(tri[:, 1], tri[:, 2])).sum() / 6.0
+    return float(abs(signed))
+
+
+def n_vertices(shape, library) -> int:
+    """The geometry's distinct corners (its triangles' shared and repeated ones counted once)."""
+    verts, faces = scope_mesh(shape, library)
+    used = verts[np.unique(faces)] if len(faces) else verts[:0]
+    return int(len(np.unique(np.round(used, 9), axis=0)))
+
+
+def n_faces(shape, library) -> int:
+    """The geometry's faces: its coplanar, connected triangles counted as one polygon."""
+    verts, faces = scope_mesh(shape, library)
+    return len(planar_faces(verts, faces)) if len(faces) else 0
+
+
+def height(shape, library) -> float:
+    """The geometry's extent along the world's vertical, in metres."""
+    verts, faces = scope_mesh(shape, library)
+    if not len(faces):
+        return 0.0
+    world_y = verts[np.unique(faces)] @ np.asarray(shape.axes, dtype=np.float64)[:, 1]
+    return float(world_y.max() - world_y.min())
+
+
+QUERIES = {
+    "geometry.area": area,
+    "geometry.volume": volume,
+    "geometry.nVertices": n_vertices,
+    "geometry.nFaces": n_faces,
+    "geometry.height": height,
+}

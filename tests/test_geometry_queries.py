@@ -1,0 +1,73 @@
+"""CGA's geometry functions (interpreter/geometry/queries.py): geometry.area, volume,
+nVertices, nFaces and height measure the shape's own geometry in metres, as CityEngine's do."""
+
+import math
+
+import pytest
+
+import bgr
+
+
+def measured(source: str, lot=(10, 20)) -> dict[str, list[float]]:
+    """Each terminal's label -> its size, where the grammar writes the measures into s()."""
+    table = bgr.derive(bgr.load(source), lot=lot).terminals.freeze()
+    return {table.label[i]: [float(v) for v in table.size[i]] for i in range(len(table))}
+
+
+def test_a_lot_and_its_extrusion():
+    sizes = measured(
+        "Lot --> [ Flat ] [ extrude(5) Box ]\n"
+        "Flat --> s(geometry.area(), geometry.volume() + 1, geometry.nVertices()) F\n"
+        "Box --> [ s(geometry.area(), geometry.volume(), geometry.height()) B ]\n"
+        "    [ s(geometry.nVertices(), geometry.nFaces(), 1) C ]\n"
+        "terminal F, B, C\n"
+    )
+    assert sizes["F"] == [200.0, 1.0, 4.0]  # a 2D shape has no volume
+    assert sizes["B"] == pytest.approx([2 * 200 + 2 * (10 + 20) * 5, 1000.0, 5.0])
+    assert sizes["C"] == [8.0, 6.0, 1.0]  # a box's corners and faces, not its triangles'
+
+
+def test_a_pyramid_roof_and_an_inserted_cube():
+    sizes = measured(
+        "Lot --> [ roof(pyramid, 45) Roof ] [ s(2, 3, 4) i(cube) Cube ]\n"
+        "Roof --> [ s(geometry.volume(), geometry.height(), geometry.nFaces()) R ]\n"
+        "    [ s(geometry.nVertices(), geometry.area(), 1) Q ]\n"
+        "Cube --> s(geometry.volume(), geometry.area(), geometry.nFaces()) K\n"
+        "terminal R, Q, K\n",
+        lot=(10, 10),
+    )
+    assert sizes["R"] == pytest.approx([100 * 5 / 3, 5.0, 4.0])  # four slopes, 5 m high
+    assert sizes["Q"] == pytest.approx([5.0, 4 * 0.5 * 10 * math.hypot(5, 5), 1.0])
+    assert sizes["K"] == pytest.approx([24.0, 52.0, 6.0])
+
+
+def test_height_is_along_the_world_vertical_whatever_the_scope():
+    # a façade's scope is turned: its y is the world's, its z points out of the wall
+    sizes = measured(
+        "Lot --> extrude(12) comp(f) { front: Wall | top: Top }\n"
+        "Wall --> s(geometry.height(), geometry.area(), 1) W\n"
+        "Top --> s(geometry.height() + 1, geometry.area(), 1) T\n"
+        "terminal W, T\n"
+    )
+    assert sizes["W"] == pytest.approx([12.0, 10 * 12, 1.0])
+    assert sizes["T"] == pytest.approx([1.0, 200.0, 1.0])
+
+
+def test_a_rule_that_asks_is_still_derived_once_and_replayed(monkeypatch):
+    source = (
+        "Lot --> extrude(30) comp(f) { side: Facade }\n"
+        "Facade --> split(y) { 3: Floor }*\n"
+        "Floor --> split(x) { ~2: Tile }*\n"
+        "Tile --> s(geometry.area(), 1, 1) T\n"
+        "terminal T\n"
+    )
+    with_reuse = bgr.derive(source, lot=(20, 10)).terminals.freeze()
+    monkeypatch.setattr("bgr.interpreter.engine.REUSE", False)
+    without = bgr.derive(source, lot=(20, 10)).terminals.freeze()
+    assert (with_reuse.size == without.size).all() and (with_reuse.origin == without.origin).all()
+    assert with_reuse.size[:, 0].tolist() == pytest.approx([6.0] * len(with_reuse))  # 2 x 3 m
+
+
+def test_the_functions_take_no_arguments():
+    with pytest.raises(bgr.BgrCheckError, match="geometry.area"):
+        bgr.load("Lot --> s(geometry.area(2), 1, 1) A\nterminal A\n")
