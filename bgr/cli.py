@@ -119,6 +119,12 @@ def build_parser() -> argparse.ArgumentParser:
         "default), a node per label (label), or one node (none)",
     )
     derive.add_argument(
+        "--reports",
+        metavar="FILE.json",
+        help="write each lot's report() values, counted, summed and averaged per key, and the "
+        "run's total, as JSON (as CityEngine's reports)",
+    )
+    derive.add_argument(
         "--instancing",
         action="store_true",
         help="glTF: store repeated parts once with EXT_mesh_gpu_instancing (smaller files; "
@@ -737,6 +743,10 @@ def cmd_derive(args) -> int:
         return EXIT_USAGE
     output = "-" if args.output in (None, "-") else args.output
     fmt = args.format if output != "-" else "json"
+    if args.reports is not None:  # refused now, not after a long derivation
+        from .grammar.paths import check_output
+
+        check_output(args.reports)
     workers = args.workers or default_workers()
     # lots from a file, streamed to a file: written by a second process while this one derives
     # (formats.background); one lot is not worth a process
@@ -778,6 +788,7 @@ def _derive(args, attrs, options, limits, workers, output, fmt, writer) -> int:
                 bar.write(d.render(), file=sys.stderr)
 
     read = FeatureOrder(warnings)  # the lot file's warnings, among the lots' in feature order
+    reported: list[dict] = []
     with (
         (writer.open_sink if writer is not None else open_sink)(
             output,
@@ -793,9 +804,20 @@ def _derive(args, attrs, options, limits, workers, output, fmt, writer) -> int:
     ):
         for result in derive_lots(job, lots, workers=workers, dask=args.dask):
             show(read.before(lots[result.index]) + result.warnings, bar)
+            if args.reports is not None:  # a lot's name, id and report() calls: not its attrs
+                reported += [
+                    {
+                        "name": lot.get("name"),
+                        "id": lot.get("id"),
+                        "reports": lot.get("reports", []),
+                    }
+                    for lot in result.table.lots
+                ]
             sink.add(result.table)
             bar.update()
         show(read.before(None), bar)
+        if args.reports is not None:  # inside the block: no output without its reports
+            _write_reports(args, reported, grammar)
     if output != "-":
         several = f" on {len(lots):,} lots" if len(lots) > 1 else ""
         print(
@@ -803,6 +825,17 @@ def _derive(args, attrs, options, limits, workers, output, fmt, writer) -> int:
             file=sys.stderr,
         )
     return EXIT_OK
+
+
+def _write_reports(args, lots: list[dict], grammar) -> None:
+    """``--reports FILE.json``: every lot's report() values summed up, and the run's."""
+    import json
+
+    from .formats.atomic import write_text
+    from .interpreter.reports import document
+
+    doc = document(lots, str(grammar.path or ""), args.seed)
+    write_text(Path(args.reports), json.dumps(doc, indent=1, allow_nan=False) + "\n")
 
 
 def _progress(lots: int, output: str):

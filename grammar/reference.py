@@ -31,7 +31,16 @@ def reference_markdown() -> str:
         "Generated from `grammar/registry.py` by `python -m bgr.grammar.reference`; do not edit.",
         "",
     ]
-    families = ["transforms", "splits", "components", "roofs", "inserts", "appearance", "texturing"]
+    families = [
+        "transforms",
+        "splits",
+        "components",
+        "roofs",
+        "inserts",
+        "appearance",
+        "reports",
+        "texturing",
+    ]
     for family in families:
         out += [
             f"## {family.capitalize()}",

@@ -16,6 +16,7 @@ NUMBER = "number"  # any numeric expression
 SIZE = "size"  # numeric expression, or 'expr relative to the current scope size
 STRING = "string"  # string expression
 COLOR = "color"  # "#rrggbb" string expression
+VALUE = "value"  # a number, a string or true/false (report's value)
 AXIS = "axis"  # x | y | z
 AXES = "axes"  # a non-empty combination of x, y, z: xz, xyz ...
 COMP_KIND = "comp kind"  # f (faces)
@@ -69,7 +70,8 @@ class Param:
 @dataclass(frozen=True)
 class Op:
     name: str
-    family: str  # transforms | splits | components | roofs | inserts | appearance | texturing
+    # transforms | splits | components | roofs | inserts | appearance | reports | texturing
+    family: str
     signatures: tuple[tuple[Param, ...], ...]
     doc: str
     example: str
@@ -269,6 +271,16 @@ OPERATIONS: dict[str, Op] = {
             _sig(Param("name", STRING)),
             "Set the semantic label written to outputs (default: the terminal rule's name).",
             'label("Window")',
+        ),
+        # -- reports -------------------------------------------------------------------------
+        Op(
+            "report",
+            "reports",
+            _sig(Param("key", STRING), Param("value", VALUE)),
+            "Report a value (a number, a string or true/false) under a key, as CGA's report(): "
+            "the shape is unchanged; each lot's reports, summed, counted and averaged per key, "
+            "are in the derive result and in `bgr derive --reports FILE.json`.",
+            'report("floor area", geometry.area())',
         ),
         # -- texturing (CGA's texturing operations; docs/language.md "Textures") -------------
         Op(

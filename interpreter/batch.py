@@ -169,6 +169,8 @@ def derive_lot(
             "properties": dict(lot.properties),
         }
     )
+    if engine.reports:  # report() calls, in order (interpreter/reports.py sums them up)
+        table.lots[-1]["reports"] = list(engine.reports)
     return LotResult(
         index,
         table.freeze(),

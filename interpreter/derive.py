@@ -49,6 +49,15 @@ class Result:
 
         return to_trimesh(self.terminals)
 
+    @property
+    def reports(self) -> list[dict]:
+        """Each lot's ``report(key, value)`` calls summed up per key: its name, id and
+        {key: {"count", "sum", "mean", "min", "max"}} (strings: {"count", "values"}), in lot
+        order (interpreter/reports.py)."""
+        from .reports import reports_of
+
+        return reports_of(self.terminals.lots)
+
     def save(self, path: str | os.PathLike, fmt: str | None = None) -> None:
         """Write by extension (.glb .gltf .obj .ply .stl .json .city.json .city.jsonl),
         atomically."""

@@ -145,6 +145,7 @@ class Engine:
         self.reuse = Reuse(replay=REUSE)
         self.shapes = 0
         self.barren_shapes = 0  # handed to rules that can never end in a terminal (.barren)
+        self.reports: list[tuple[str, object]] = []  # report(key, value) calls, in order
         self._bindings: dict = {}
         self._exprs: dict[int, object] = {}
         self._flat_ids: dict[tuple, int] = {}
@@ -260,6 +261,7 @@ class Engine:
                         self.triangles,
                         len(table.tex_rows),
                         len(self.warnings),
+                        len(self.reports),
                     )
                     # derived at the world's origin and moved when done (reuse.py), so that
                     # a replay and a derivation make the same numbers

@@ -325,8 +325,8 @@ class Reuse:
     def record(self, engine, key, where: tuple, start: int, marks: tuple) -> None:
         """Move the rows a subtree emitted (``start`` on, derived at the world's origin) to
         ``where``, its shape's (origin, path) when the rule was applied; keep them for replays
-        the second time the key is seen, unless the subtree made textured rows or warnings,
-        which are not replayed."""
+        the second time the key is seen, unless the subtree made textured rows, warnings or
+        reports, which are not replayed."""
         t = engine.table
         (ox, oy, oz), path = where
         local = t.origin[start:]
@@ -337,8 +337,12 @@ class Reuse:
         if key not in self.seen and len(local) > FIRST_MOST:
             self.seen.add(key)  # a large subtree is kept once it repeats (a façade rarely does)
             return
-        shapes, barren, triangles, textured, warned = marks
-        if len(t.tex_rows) != textured or len(engine.warnings) != warned:
+        shapes, barren, triangles, textured, warned, reported = marks
+        if (
+            len(t.tex_rows) != textured
+            or len(engine.warnings) != warned
+            or len(engine.reports) != reported  # a replay would not report them again
+        ):
             return
         self.rows += len(local)
         while self.rows > KEEP_MOST and self.records:  # forget the least recently replayed

@@ -6,7 +6,7 @@ application (for evaluating, spawning pieces and reporting errors), ``shape`` th
 scope ``center()`` aligns to.  It returns True when the shape is used up (split, comp, roof...).
 """
 
-from . import appearance, components, inserts, roofs, splits, texturing, transforms
+from . import appearance, components, inserts, reporting, roofs, splits, texturing, transforms
 
 IMPLEMENTATIONS = {
     "t": transforms.translate,
@@ -27,6 +27,7 @@ IMPLEMENTATIONS = {
     "color": appearance.color,
     "material": appearance.material,
     "label": appearance.label,
+    "report": reporting.report,
     "setupProjection": texturing.setup_projection,
     "projectUV": texturing.project_uv,
     "texture": texturing.texture,
