@@ -6,8 +6,8 @@ Extracts the ``--baseline`` commit with ``git archive`` into a temporary folder,
 the installed package (``pyproject.toml``'s package-dir mapping) and runs its ``bgr derive`` of
 the Helsinki command alternately with this checkout's, in fresh processes: wall seconds of each
 pair, their ratio, the medians, and the md5 of both GLBs (they must be the same bytes).
-``--one-process`` sets ``BGR_BACKGROUND=0`` for this checkout (no writer process beside the
-derivation: the derivation's own speed-up).
+``--one-process`` sets ``BGR_BACKGROUND=0`` for both sides (no writer process beside the
+derivation, where the baseline has one: the derivation's own speed-up).
 """
 
 from __future__ import annotations
@@ -83,7 +83,7 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--baseline", required=True, help="the commit to compare against")
     ap.add_argument("--pairs", type=int, default=7)
-    ap.add_argument("--one-process", action="store_true", help="BGR_BACKGROUND=0 for this side")
+    ap.add_argument("--one-process", action="store_true", help="BGR_BACKGROUND=0 for both sides")
     ap.add_argument("--workers", default="1", help="--workers for both sides")
     args = ap.parse_args()
     with tempfile.TemporaryDirectory() as tmp:
@@ -97,7 +97,7 @@ def main() -> None:
         before, after = [], []
         print(f"baseline {args.baseline} vs {ROOT} (one process: {args.one_process})")
         for k in range(args.pairs):
-            before.append(timed([*old, "-o", str(old_glb)], env))
+            before.append(timed([*old, "-o", str(old_glb)], new_env))
             after.append(timed([*new, "-o", str(new_glb)], new_env))
             print(f"pair {k + 1}: {before[-1]:6.2f} s  {after[-1]:6.2f} s  "
                   f"{before[-1] / after[-1]:5.2f}x", flush=True)  # fmt: skip

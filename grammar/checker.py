@@ -18,6 +18,7 @@ from .errors import Diagnostic, source_line, suggest
 from .formatter import format_params
 from .limits import MAX_NESTING, children, expr_depth, expressions
 from .registry import (
+    ATTR_NAME,
     AXES,
     AXIS,
     AXIS_NAMES,
@@ -100,6 +101,7 @@ class Grammar:
     recursive_funcs: set[str] = field(default_factory=set)  # funcs that call themselves
     warnings: list[Diagnostic] = field(default_factory=list)  # bgr.load: its own and its imports'
     barren: dict[str, str] = field(default_factory=dict)  # rule -> its cycle (.productive)
+    settable: set[str] = field(default_factory=set)  # attrs a set() of its rules changes
 
     def lookup_module(self, dotted: str) -> tuple[Grammar, str]:
         """Split ``alias.Name`` into (module, member); a plain name is this module's own."""
@@ -474,7 +476,28 @@ class Checker:
         )
         return None
 
+    def set_target(self, arg, op: Op) -> None:
+        """set()'s first argument: a bare word naming an attr of this file."""
+        if not isinstance(arg, n.Name):
+            self.error(arg.pos, "set() changes an attr: name it bare", f"for example: {op.example}")
+        elif arg.name in self.g.consts:
+            self.error(arg.pos, f"'{arg.name}' is a const: set() changes attrs only")
+        elif arg.name in self.g.attrs:
+            self.g.settable.add(arg.name)
+        else:
+            hint = "set() changes this file's own attrs (declare it: attr NAME = value)"
+            if "." in arg.name:
+                hint = "set() changes this file's own attrs, not an imported file's"
+            self.error(
+                arg.pos,
+                f"unknown attr '{arg.name}'",
+                suggest(arg.name, list(self.g.attrs)) or hint,
+            )
+
     def op_arg(self, arg, kind: str, pname: str, op: Op, local: set[str]) -> None:
+        if kind == ATTR_NAME:
+            self.set_target(arg, op)
+            return
         if kind in _SYMBOL_KINDS or kind in (AXES, GEOMETRY):
             if not isinstance(arg, n.Name):
                 allowed = self.allowed_symbols(kind)

@@ -38,6 +38,7 @@ def reference_markdown() -> str:
         "roofs",
         "inserts",
         "appearance",
+        "attributes",
         "reports",
         "texturing",
     ]

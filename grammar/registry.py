@@ -17,6 +17,7 @@ SIZE = "size"  # numeric expression, or 'expr relative to the current scope size
 STRING = "string"  # string expression
 COLOR = "color"  # "#rrggbb" string expression
 VALUE = "value"  # a number, a string or true/false (report's value)
+ATTR_NAME = "attr name"  # a bare word naming an attr of the file (set's first argument)
 AXIS = "axis"  # x | y | z
 AXES = "axes"  # a non-empty combination of x, y, z: xz, xyz ...
 COMP_KIND = "comp kind"  # f (faces)
@@ -70,7 +71,8 @@ class Param:
 @dataclass(frozen=True)
 class Op:
     name: str
-    # transforms | splits | components | roofs | inserts | appearance | reports | texturing
+    # transforms | splits | components | roofs | inserts | appearance | attributes | reports
+    # | texturing
     family: str
     signatures: tuple[tuple[Param, ...], ...]
     doc: str
@@ -271,6 +273,16 @@ OPERATIONS: dict[str, Op] = {
             _sig(Param("name", STRING)),
             "Set the semantic label written to outputs (default: the terminal rule's name).",
             'label("Window")',
+        ),
+        # -- attributes ----------------------------------------------------------------------
+        Op(
+            "set",
+            "attributes",
+            _sig(Param("attribute", ATTR_NAME), Param("value", VALUE)),
+            "Set an attr of this file for the shape and every shape derived from it, as CGA's "
+            "set(): rules below read the new value, the rest of the lot the old one (attrs "
+            "computed from it keep theirs).",
+            "set(floors, floors - 1)",
         ),
         # -- reports -------------------------------------------------------------------------
         Op(

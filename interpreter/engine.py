@@ -17,6 +17,7 @@ from bgr.grammar import nodes as n
 from bgr.grammar.checker import bind_problem
 from bgr.grammar.errors import BgrError, Diagnostic, Warnings, suggest
 from bgr.grammar.registry import (
+    ATTR_NAME,
     AXES,
     AXIS,
     COMP_KIND,
@@ -55,6 +56,7 @@ from .shapes import Flat, Shape, Solid
 from .terminals import MeshLibrary, TerminalTable, UnitMesh
 
 SYMBOL_KINDS = {
+    ATTR_NAME,
     AXIS,
     AXES,
     COMP_KIND,

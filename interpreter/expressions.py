@@ -175,6 +175,18 @@ class Compiler:
             return lambda ctx: ctx.args[name]
         if name in self.values:
             values = self.values
+            if name in getattr(self.module, "settable", ()):  # set() may have changed it here
+                key = (id(self.module), name)
+
+                def attr(ctx):
+                    shape = ctx.shape
+                    if shape is not None and shape.attrs:
+                        for k, v in shape.attrs:
+                            if k == key:
+                                return v
+                    return values[name]
+
+                return attr
             return lambda ctx: values[name]
         if name == "scope.sx":
             return lambda ctx: ctx.shape.size[0]

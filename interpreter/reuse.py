@@ -302,6 +302,7 @@ class Reuse:
             shape.material,
             shape.label,
             shape.depth,
+            shape.attrs,  # values set() gave attrs for this shape and what it derives
         )
         try:
             found = self.records.get(key)

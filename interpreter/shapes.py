@@ -59,6 +59,7 @@ class Shape:
         "depth",
         "frame",
         "tex",
+        "attrs",
     )
 
     def __init__(
@@ -86,6 +87,9 @@ class Shape:
         self.depth = depth
         self.frame = None  # (origin, axes) of the shape this one was cut from; None: the world
         self.tex = None  # texturing.Texturing (projections, coordinates, maps), None: plain
+        # attrs set() on this shape or an ancestor: ((id(module), name), value) pairs sorted by
+        # key, a tuple so that it can be part of a reuse key; None: none (operations/attributes)
+        self.attrs: tuple | None = None
 
     def copy(self) -> Shape:
         # slot by slot, not through __init__: a derivation copies shapes millions of times
@@ -102,6 +106,7 @@ class Shape:
         twin.depth = self.depth
         twin.frame = self.frame
         twin.tex = self.tex  # immutable: shared until an operation replaces it
+        twin.attrs = self.attrs  # immutable too
         return twin
 
     def cut_from(self, parent: Shape) -> Shape:

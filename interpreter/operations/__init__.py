@@ -6,7 +6,17 @@ application (for evaluating, spawning pieces and reporting errors), ``shape`` th
 scope ``center()`` aligns to.  It returns True when the shape is used up (split, comp, roof...).
 """
 
-from . import appearance, components, inserts, reporting, roofs, splits, texturing, transforms
+from . import (
+    appearance,
+    attributes,
+    components,
+    inserts,
+    reporting,
+    roofs,
+    splits,
+    texturing,
+    transforms,
+)
 
 IMPLEMENTATIONS = {
     "t": transforms.translate,
@@ -28,6 +38,7 @@ IMPLEMENTATIONS = {
     "material": appearance.material,
     "label": appearance.label,
     "report": reporting.report,
+    "set": attributes.set_attr,
     "setupProjection": texturing.setup_projection,
     "projectUV": texturing.project_uv,
     "texture": texturing.texture,

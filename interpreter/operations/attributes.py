@@ -1,0 +1,29 @@
+"""set(attribute, value): CGA's set() of a user attribute, for a shape and what it derives.
+
+In CGA an attribute's value belongs to the shape: ``set`` changes it for the current shape, and
+the shapes derived from it afterwards inherit the new value; the rest of the lot keeps the old.
+bgr keeps the values set so far on the shape (``Shape.attrs``: a sorted tuple of
+((module id, name), value), shared by copies until the next ``set``), and a rule reads an attr
+that some ``set`` of its file changes from there first (expressions.Compiler.name).  Attrs
+computed from the changed one keep the values they had when the lot began, as in CGA.
+"""
+
+from __future__ import annotations
+
+from ..expressions import RuleRef, runtime_error
+
+
+def set_attr(app, shape, step, args) -> bool:
+    name, value = args[0], args[1]
+    if isinstance(value, RuleRef):
+        raise runtime_error(
+            app.module,
+            step.pos,
+            f"set({name}, ...) takes a number, a string or true/false, not the rule "
+            f"'{value.member}'",
+        )
+    key = (id(app.module), name)
+    values = dict(shape.attrs or ())
+    values[key] = value
+    shape.attrs = tuple(sorted(values.items()))
+    return False
