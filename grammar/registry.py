@@ -427,6 +427,15 @@ BUILTINS: dict[str, Builtin] = {
         Builtin("tan", 1, 1, "tan(deg)", "tangent of an angle in degrees."),
         Builtin("clamp", 3, 3, "clamp(x, lo, hi)", "x limited to the range lo..hi."),
         Builtin(
+            "str",
+            1,
+            1,
+            "str(x)",
+            'x as text, as CGA\'s str(): str(1.69) is "1.69", str(2) "2", str(true) "true" '
+            "(numbers to 10 significant digits); a string joined with + to a number or a "
+            'boolean converts it the same way ("Floor" + 2 is "Floor2").',
+        ),
+        Builtin(
             "geometry.isRectangular",
             0,
             1,

@@ -119,6 +119,18 @@ def _show(value) -> str:
     return repr(value)  # numbers, and RuleRef: "the rule 'Arched'"
 
 
+def as_text(value) -> str | None:
+    """CGA's str(): a string as it is, true/false, a number to 10 significant digits without a
+    trailing ".0" (str(1.69) is "1.69", str(2.0) "2"); None for what has no text (a rule)."""
+    if isinstance(value, str):
+        return value
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, (int, float)):
+        return format(value, ".10g")
+    return None
+
+
 _ARITH = {
     "+": operator.add,
     "-": operator.sub,
@@ -314,8 +326,12 @@ class Compiler:
 
         def arith(a, right, ctx):
             b = right(ctx)
-            if op == "+" and isinstance(a, str) and isinstance(b, str):
-                return a + b
+            if op == "+" and (isinstance(a, str) or isinstance(b, str)):
+                # a string and a number or boolean join as text, as in CGA ("Floor" + 2)
+                left, right_text = as_text(a), as_text(b)
+                if left is None or right_text is None:
+                    raise runtime_error(module, pos, f"cannot join {_show(a)} and {_show(b)}")
+                return left + right_text
             try:
                 result = fn(_num(module, pos, a), _num(module, pos, b))
             except ZeroDivisionError:
@@ -359,6 +375,16 @@ class Compiler:
         if name in ("min", "max"):
             fn = min if name == "min" else max
             return lambda ctx: fn(_num(module, pos, a(ctx)) for a in args)
+        if name == "str":
+            (value,) = args
+
+            def text(ctx):
+                found = as_text(value(ctx))
+                if found is None:
+                    raise runtime_error(module, pos, f"str() of {_show(value(ctx))}")
+                return found
+
+            return text
         if name == "clamp":
             x, lo, hi = args
             return lambda ctx: min(
