@@ -1,0 +1,194 @@
+"""CityEngine CGA's operations and functions beside bgr's: docs/cga.md, generated.
+
+    python -m bgr.grammar.cga_table > docs/cga.md
+
+:data:`CGA` lists what CGA's reference index names (operations, then functions and other
+words), each with what bgr writes for it and a status: **same** (the same name and meaning),
+**different** (another spelling, given), **partly** (some of its forms) or **not yet**.  Where
+bgr has an operation or a function of the same name, its usage comes from the registry
+(grammar/registry.py), so the table cannot drift from the language; a test keeps docs/cga.md
+equal to this output and checks that every registry entry CGA also has is listed.
+"""
+
+from __future__ import annotations
+
+from .registry import BUILTINS, OPERATIONS
+
+SAME, DIFFERENT, PARTLY, NOT_YET = "same", "different", "partly", "not yet"
+
+# (CGA name, status, what bgr writes where the registry cannot say it, a note)
+CGA: list[tuple[str, str, str, str]] = [
+    # ---- operations ------------------------------------------------------------------------
+    ("alignScopeToAxes", NOT_YET, "", ""),
+    ("alignScopeToGeometry", NOT_YET, "", ""),
+    ("center", SAME, "", ""),
+    ("cleanupGeometry", NOT_YET, "", ""),
+    ("color", SAME, "", ""),
+    ("comp", PARTLY, "", "faces (`comp(f)`) with their selectors; edges and vertices not yet"),
+    ("convexify", NOT_YET, "", ""),
+    ("deleteHoles", NOT_YET, "", ""),
+    ("deleteUV", SAME, "", ""),
+    ("envelope", NOT_YET, "", ""),
+    ("extrude", SAME, "", ""),
+    ("i", SAME, "", 'a file path is declared first: `asset x = "x.obj"`, then `i(x)`'),
+    ("innerRectangle", NOT_YET, "", "`innerRect` in older releases"),
+    ("insertAlongUV", NOT_YET, "", ""),
+    ("label", SAME, "", ""),
+    ("mirror", NOT_YET, "", ""),
+    ("mirrorScope", NOT_YET, "", ""),
+    ("NIL", SAME, "NIL", ""),
+    ("normalizeUV", SAME, "", ""),
+    ("offset", DIFFERENT, "", "a positive distance shrinks (CGA's negative one)"),
+    ("primitiveCube", DIFFERENT, "i(cube)", "also `cylinder`, `sphere`, `quad`, `wedge`"),
+    ("print", NOT_YET, "", ""),
+    ("projectUV", SAME, "", ""),
+    ("r", PARTLY, "", "about the scope's origin; `r(scopeCenter, ...)` not yet"),
+    ("report", SAME, "", "each lot's values summed up per key; `bgr derive --reports`"),
+    ("resetMaterial", NOT_YET, "", ""),
+    ("reverseNormals", SAME, "", ""),
+    ("roofGable", DIFFERENT, "roof(gable, pitch, overhang)", ""),
+    ("roofHip", DIFFERENT, "roof(hip, pitch, overhang)", ""),
+    ("roofPyramid", DIFFERENT, "roof(pyramid, pitch, overhang)", ""),
+    ("roofShed", DIFFERENT, "roof(shed, pitch, overhang)", ""),
+    ("rotate", NOT_YET, "", "the scope's own turn is `r`"),
+    ("rotateScope", NOT_YET, "", ""),
+    ("rotateUV", SAME, "", ""),
+    ("s", SAME, "", ""),
+    ("scaleUV", SAME, "", ""),
+    ("scatter", NOT_YET, "", ""),
+    (
+        "set",
+        PARTLY,
+        "",
+        "attrs; `set(material.name, v)` is `material(v)`; other shape attributes not yet",
+    ),  # fmt: skip
+    ("setback", NOT_YET, "", ""),
+    ("setNormals", NOT_YET, "", ""),
+    ("setPivot", NOT_YET, "", ""),
+    ("setupProjection", SAME, "", ""),
+    ("shapeL", DIFFERENT, "footprint(L, a, b)", "wing widths as fractions of the scope"),
+    ("shapeO", DIFFERENT, "footprint(circle, sides)", "a ring of sides"),
+    ("shapeU", DIFFERENT, "footprint(U, a, b)", ""),
+    ("softenNormals", NOT_YET, "", ""),
+    ("split", SAME, "", "absolute, `'` relative and `~` floating sizes, `{ ... }*` repeats"),
+    ("splitArea", NOT_YET, "", ""),
+    ("t", SAME, "", ""),
+    ("taper", SAME, "", ""),
+    ("texture", SAME, "", ""),
+    ("tileUV", SAME, "", ""),
+    ("translate", NOT_YET, "", "the scope's own move is `t`"),
+    ("translateUV", SAME, "", ""),
+    ("trim", NOT_YET, "", ""),
+    # ---- functions -------------------------------------------------------------------------
+    ("abs", SAME, "", ""),
+    ("acos", NOT_YET, "", ""),
+    ("asin", NOT_YET, "", ""),
+    ("atan", NOT_YET, "", ""),
+    ("atan2", NOT_YET, "", ""),
+    ("bool", NOT_YET, "", ""),
+    ("ceil", SAME, "", ""),
+    ("cos", SAME, "", ""),
+    ("count", NOT_YET, "", ""),
+    ("exp", NOT_YET, "", ""),
+    ("fileExists", NOT_YET, "", ""),
+    ("find", NOT_YET, "", ""),
+    ("float", NOT_YET, "", ""),
+    ("floor", SAME, "", ""),
+    ("geometry.angle", NOT_YET, "", ""),
+    ("geometry.area", PARTLY, "", "with brackets, and without face selectors"),
+    ("geometry.boundaryLength", NOT_YET, "", ""),
+    ("geometry.height", SAME, "", "with brackets"),
+    ("geometry.isConcave", NOT_YET, "", ""),
+    ("geometry.isPlanar", NOT_YET, "", ""),
+    ("geometry.isRectangular", SAME, "", ""),
+    ("geometry.nEdges", NOT_YET, "", ""),
+    ("geometry.nFaces", SAME, "", "with brackets"),
+    ("geometry.nHoles", NOT_YET, "", ""),
+    ("geometry.nVertices", SAME, "", "with brackets"),
+    ("geometry.volume", SAME, "", "with brackets"),
+    ("inside", NOT_YET, "", "occlusion queries"),
+    ("isinf", NOT_YET, "", ""),
+    ("isnan", NOT_YET, "", ""),
+    ("len", NOT_YET, "", ""),
+    ("ln", NOT_YET, "", ""),
+    ("log10", NOT_YET, "", ""),
+    ("max", SAME, "", ""),
+    ("min", SAME, "", ""),
+    ("overlaps", NOT_YET, "", "occlusion queries"),
+    ("p", NOT_YET, "", "a stochastic rule: `30%: A | else: B`"),
+    ("pow", DIFFERENT, "a ** b", ""),
+    ("rand", SAME, "", ""),
+    ("rint", DIFFERENT, "round(x)", "halves away from zero"),
+    ("sin", SAME, "", ""),
+    ("splitString", NOT_YET, "", ""),
+    ("sqrt", SAME, "", ""),
+    ("str", SAME, "", "and `+` joining a string with a number"),
+    ("substring", NOT_YET, "", ""),
+    ("tan", SAME, "", ""),
+    ("touches", NOT_YET, "", "occlusion queries"),
+    # ---- other words -----------------------------------------------------------------------
+    (
+        "@Range, @Enum, @Group, ... (annotations)",
+        SAME,
+        "@Range(min = 1, max = 20)",
+        "metadata, checked; `bgr.attr_metadata`",
+    ),  # fmt: skip
+    ("attr", SAME, "attr name = value", ""),
+    ("case / else", DIFFERENT, "case c: A | else: B", "branches separated by `|`"),
+    ("const", SAME, "const name = value", ""),
+    ("import", DIFFERENT, 'import "file.bgr" as name', "then `name.Rule`"),
+    ("scope.sx, scope.sy, scope.sz", SAME, "scope.sx, scope.sy, scope.sz", ""),
+    ("scope.tx, scope.ty, scope.tz", DIFFERENT, "scope.x, scope.y, scope.z", ""),
+    ("split.index, split.total, comp.index, comp.total", SAME, "split.index", "and the others"),
+    ("@StartRule", DIFFERENT, "start Name", "or the first rule; the annotation is kept too"),
+]
+
+# registry entries CGA has no word for: bgr's own
+BGR_ONLY = {"matrix", "footprint", "polygon", "normalMap", "material", "roof", "clamp",
+            "randint", "round"}  # fmt: skip
+
+
+def usage(name: str) -> str:
+    """bgr's usage of a name the registry knows ('' when it does not)."""
+    if name in OPERATIONS:
+        return OPERATIONS[name].usage()
+    if name in BUILTINS:
+        return BUILTINS[name].usage
+    return ""
+
+
+def table() -> str:
+    """docs/cga.md."""
+    counts = {s: sum(1 for _, status, _, _ in CGA if status == s) for s in (SAME, DIFFERENT,
+              PARTLY, NOT_YET)}  # fmt: skip
+    lines = [
+        "# CGA and bgr",
+        "",
+        "<!-- generated by `python -m bgr.grammar.cga_table > docs/cga.md`; edit "
+        "grammar/cga_table.py -->",
+        "",
+        "CityEngine CGA's operations, functions and other words (its reference index) with "
+        "what bgr writes for each. **same**: the same name and meaning; **different**: "
+        "another spelling; **partly**: some of its forms; **not yet**. Where bgr has the "
+        "same name, its usage comes from bgr's operation registry. The semantics of each "
+        "are in [language.md](language.md); section 14 there is the short version.",
+        "",
+        f"{counts[SAME]} same, {counts[DIFFERENT]} different, {counts[PARTLY]} partly, "
+        f"{counts[NOT_YET]} not yet, of {len(CGA)}.",
+        "",
+        "| CGA | status | bgr | note |",
+        "|---|---|---|---|",
+    ]
+    for name, status, written, note in CGA:
+        bgr = (written or usage(name)).replace("|", "\\|")  # a cell's | would end it
+        note = note.replace("|", "\\|")
+        lines.append(
+            f"| `{name}` | {status} | {f'`{bgr}`' if bgr else ''} | {note} |"
+            if "(" not in name and "," not in name and "/" not in name
+            else f"| {name} | {status} | {f'`{bgr}`' if bgr else ''} | {note} |"
+        )
+    return "\n".join(lines) + "\n"
+
+
+if __name__ == "__main__":
+    print(table(), end="")
