@@ -119,6 +119,41 @@ def _show(value) -> str:
     return repr(value)  # numbers, and RuleRef: "the rule 'Arched'"
 
 
+def number_text(text: str) -> float | None:
+    """A string that spells a finite number, as that number; None otherwise."""
+    try:
+        value = float(text)
+    except ValueError:
+        return None
+    return value if math.isfinite(value) else None
+
+
+def _find(text: str, match: str, n: float) -> float:
+    """CGA's find(): where the n-th (0-based) occurrence of ``match`` starts, or -1."""
+    at, start = -1, 0
+    for _ in range(int(n) + 1):
+        at = text.find(match, start)
+        if at < 0 or not match:
+            return float(at)
+        start = at + len(match)
+    return float(at)
+
+
+def _substring(text: str, start: float, end: float) -> str:
+    """CGA's substring(): the characters from ``start`` up to, not including, ``end``."""
+    lo = max(0, int(start))
+    hi = max(lo, min(len(text), int(end)))
+    return text[lo:hi]
+
+
+_TEXT = {
+    "len": (lambda s: float(len(s)), (str,)),
+    "count": (lambda s, m: float(s.count(m)) if m else 0.0, (str, str)),
+    "find": (_find, (str, str, float)),
+    "substring": (_substring, (str, float, float)),
+}
+
+
 def as_text(value) -> str | None:
     """CGA's str(): a string as it is, true/false, a number to 10 significant digits without a
     trailing ".0" (str(1.69) is "1.69", str(2.0) "2"); None for what has no text (a rule)."""
@@ -162,6 +197,16 @@ _MATH = {
     "cos": _deg(math.cos),
     "tan": _deg(math.tan),
     "round": lambda x: math.floor(x + 0.5) if x >= 0 else -math.floor(-x + 0.5),
+    # CGA's other math functions: inverse trigonometry answers in degrees, as sin() takes them
+    "acos": lambda x: math.degrees(math.acos(x)),
+    "asin": lambda x: math.degrees(math.asin(x)),
+    "atan": lambda x: math.degrees(math.atan(x)),
+    "exp": math.exp,
+    "ln": math.log,
+    "log10": math.log10,
+    "rint": lambda x: float(round(x)),  # the nearest whole number, halves to the even one
+    "isinf": math.isinf,
+    "isnan": math.isnan,
 }
 
 
@@ -375,6 +420,56 @@ class Compiler:
         if name in ("min", "max"):
             fn = min if name == "min" else max
             return lambda ctx: fn(_num(module, pos, a(ctx)) for a in args)
+        if name in _TEXT:  # CGA's string functions: len, count, find, substring
+            fn, kinds = _TEXT[name]
+
+            def text_call(ctx):
+                values = [f(ctx) for f in args]
+                for value, kind in zip(values, kinds, strict=False):
+                    if kind is str and not isinstance(value, str):
+                        raise runtime_error(
+                            module, pos, f"{name}() needs a string, got {_show(value)}"
+                        )
+                    if kind is float:
+                        _num(module, pos, value)
+                return fn(*values)
+
+            return text_call
+        if name == "atan2":
+            y, x = args
+            return lambda ctx: math.degrees(
+                math.atan2(_num(module, pos, y(ctx)), _num(module, pos, x(ctx)))
+            )
+        if name == "p":  # CGA's p(prob): true with that probability, from the shape's stream
+            (prob,) = args
+            return lambda ctx: ctx.stream.uniform() < _num(module, pos, prob(ctx))
+        if name == "float":
+            (value,) = args
+
+            def to_float(ctx):
+                v = value(ctx)
+                if isinstance(v, str):
+                    found = number_text(v)
+                    if found is None:  # CGA gives NaN; bgr's numbers are finite
+                        raise runtime_error(module, pos, f"float() of {_show(v)}: not a number")
+                    return found
+                if isinstance(v, bool):
+                    return 1.0 if v else 0.0
+                return _num(module, pos, v)
+
+            return to_float
+        if name == "bool":
+            (value,) = args
+
+            def to_bool(ctx):
+                v = value(ctx)
+                if isinstance(v, str):
+                    return v.strip().lower() in ("true", "1")
+                if isinstance(v, bool):
+                    return v
+                return _num(module, pos, v) != 0
+
+            return to_bool
         if name == "str":
             (value,) = args
 

@@ -43,7 +43,7 @@ PLACED = {
     "depth",
     "seed",
 }
-RANDOM = {"rand", "randint"}
+RANDOM = {"rand", "randint", "p"}
 # a subtree of up to this many terminals is kept the first time it is derived (a tile, a floor);
 # a larger one the second time (grid_city at n = 20: 1.34 s and 374 MB keeping all the first
 # time, 1.65 s and 281 MB keeping all the second time)
