@@ -804,6 +804,9 @@ def _derive(args, attrs, options, limits, workers, output, fmt, writer) -> int:
     ):
         for result in derive_lots(job, lots, workers=workers, dask=args.dask):
             show(read.before(lots[result.index]) + result.warnings, bar)
+            for lot in result.table.lots:  # the grammar's print() calls, as CGA's console
+                for text in lot.get("prints", ()):
+                    bar.write(text, file=sys.stderr)
             if args.reports is not None:  # a lot's name, id and report() calls: not its attrs
                 reported += [
                     {

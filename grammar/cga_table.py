@@ -40,7 +40,7 @@ CGA: list[tuple[str, str, str, str]] = [
     ("normalizeUV", SAME, "", ""),
     ("offset", DIFFERENT, "", "a positive distance shrinks (CGA's negative one)"),
     ("primitiveCube", DIFFERENT, "i(cube)", "also `cylinder`, `sphere`, `quad`, `wedge`"),
-    ("print", NOT_YET, "", ""),
+    ("print", SAME, "", "on standard error, each lot's in derivation order"),
     ("projectUV", SAME, "", ""),
     ("r", PARTLY, "", "about the scope's origin; `r(scopeCenter, ...)` not yet"),
     ("report", SAME, "", "each lot's values summed up per key; `bgr derive --reports`"),

@@ -294,6 +294,15 @@ OPERATIONS: dict[str, Op] = {
             "are in the derive result and in `bgr derive --reports FILE.json`.",
             'report("floor area", geometry.area())',
         ),
+        Op(
+            "print",
+            "reports",
+            _sig(Param("value", VALUE)),
+            "Print a value (as str() writes it) on the console, as CGA's print(): `bgr derive` "
+            "writes each lot's prints on standard error, in derivation order; the shape is "
+            "unchanged.",
+            'print("floors: " + floors)',
+        ),
         # -- texturing (CGA's texturing operations; docs/language.md "Textures") -------------
         Op(
             "setupProjection",

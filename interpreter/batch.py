@@ -171,6 +171,8 @@ def derive_lot(
     )
     if engine.reports:  # report() calls, in order (interpreter/reports.py sums them up)
         table.lots[-1]["reports"] = list(engine.reports)
+    if engine.prints:  # print() texts, in order: bgr derive writes them
+        table.lots[-1]["prints"] = list(engine.prints)
     return LotResult(
         index,
         table.freeze(),

@@ -58,6 +58,11 @@ class Result:
 
         return reports_of(self.terminals.lots)
 
+    @property
+    def prints(self) -> list[str]:
+        """What the grammar's print() calls wrote, lot after lot, in derivation order."""
+        return [text for lot in self.terminals.lots for text in lot.get("prints", ())]
+
     def save(self, path: str | os.PathLike, fmt: str | None = None) -> None:
         """Write by extension (.glb .gltf .obj .ply .stl .json .city.json .city.jsonl),
         atomically."""

@@ -148,6 +148,7 @@ class Engine:
         self.shapes = 0
         self.barren_shapes = 0  # handed to rules that can never end in a terminal (.barren)
         self.reports: list[tuple[str, object]] = []  # report(key, value) calls, in order
+        self.prints: list[str] = []  # print(value) texts, in order
         self._bindings: dict = {}
         self._exprs: dict[int, object] = {}
         self._flat_ids: dict[tuple, int] = {}
@@ -263,7 +264,7 @@ class Engine:
                         self.triangles,
                         len(table.tex_rows),
                         len(self.warnings),
-                        len(self.reports),
+                        len(self.reports) + len(self.prints),
                     )
                     # derived at the world's origin and moved when done (reuse.py), so that
                     # a replay and a derivation make the same numbers

@@ -326,8 +326,8 @@ class Reuse:
     def record(self, engine, key, where: tuple, start: int, marks: tuple) -> None:
         """Move the rows a subtree emitted (``start`` on, derived at the world's origin) to
         ``where``, its shape's (origin, path) when the rule was applied; keep them for replays
-        the second time the key is seen, unless the subtree made textured rows, warnings or
-        reports, which are not replayed."""
+        the second time the key is seen, unless the subtree made textured rows, warnings,
+        reports or prints, which are not replayed."""
         t = engine.table
         (ox, oy, oz), path = where
         local = t.origin[start:]
@@ -342,7 +342,7 @@ class Reuse:
         if (
             len(t.tex_rows) != textured
             or len(engine.warnings) != warned
-            or len(engine.reports) != reported  # a replay would not report them again
+            or len(engine.reports) + len(engine.prints) != reported  # nor report nor print
         ):
             return
         self.rows += len(local)

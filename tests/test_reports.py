@@ -116,3 +116,25 @@ def test_a_reports_file_that_cannot_be_written_stops_the_run_before_it_starts(tm
     proc = cli("derive", "g.bgr", "-o", "out.glb", "--reports", "/proc/reports.json", cwd=tmp_path)
     assert proc.returncode == 1 and "Traceback" not in proc.stderr, proc.stderr
     assert not (tmp_path / "out.glb").exists()
+
+
+def test_print_writes_each_call_in_order_derived_or_not(tmp_path):
+    source = (
+        "attr floors = 3\n"
+        'Lot --> print("floors: " + floors) extrude(9) comp(f) { side: Facade | top: Roof }\n'
+        "Facade --> split(y) { 3: Floor }*\n"
+        'Floor --> print("floor " + split.index) Wall\n'
+        "terminal Wall, Roof\n"
+    )
+    prints = bgr.derive(source, lot=(10, 8)).prints
+    # four sides of three floors each: a floor that prints is derived, not replayed
+    assert prints == ["floors: 3"] + [f"floor {i}" for i in range(3)] * 4
+    (tmp_path / "g.bgr").write_text(source)
+    lots_file(tmp_path / "lots.geojson", n=3)
+    outs = []
+    for workers in ("1", "2"):
+        proc = cli("derive", "g.bgr", "--lot", "lots.geojson", "-o", f"o{workers}.glb",
+                   "--workers", workers, cwd=tmp_path)  # fmt: skip
+        assert proc.returncode == 0, proc.stderr
+        outs.append([line for line in proc.stderr.splitlines() if line.startswith("floor")])
+    assert outs[0] == outs[1] == (["floors: 3"] + [f"floor {i}" for i in range(3)] * 4) * 3

@@ -38,6 +38,7 @@ IMPLEMENTATIONS = {
     "material": appearance.material,
     "label": appearance.label,
     "report": reporting.report,
+    "print": reporting.print_value,
     "set": attributes.set_attr,
     "setupProjection": texturing.setup_projection,
     "projectUV": texturing.project_uv,
