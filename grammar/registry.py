@@ -560,6 +560,12 @@ BUILTIN_NAMES: dict[str, str] = {
     ),
     "comp.right": "the corner at the face's right edge, as comp.left",
     "depth": "derivation depth of the shape",
+    # CGA writes its geometry functions without brackets too: `case geometry.area < 100`
+    "geometry.area": "geometry.area(), written bare as CGA allows",
+    "geometry.volume": "geometry.volume(), written bare",
+    "geometry.nVertices": "geometry.nVertices(), written bare",
+    "geometry.nFaces": "geometry.nFaces(), written bare",
+    "geometry.height": "geometry.height(), written bare",
     "seed": "the global seed",
 }
 

@@ -268,6 +268,11 @@ class Compiler:
             return lambda ctx: ctx.comp_right
         if name == "depth":
             return lambda ctx: ctx.shape.depth
+        if name in _GEOMETRY_QUERIES:  # geometry.area written bare, as CGA allows
+            from .geometry.queries import QUERIES
+
+            query = QUERIES[name]
+            return lambda ctx: query(ctx.shape, ctx.library)
         if name == "seed":
             return lambda ctx: ctx.seed
         module, member = self.module.lookup_module(name)

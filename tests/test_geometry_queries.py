@@ -71,3 +71,15 @@ def test_a_rule_that_asks_is_still_derived_once_and_replayed(monkeypatch):
 def test_the_functions_take_no_arguments():
     with pytest.raises(bgr.BgrCheckError, match="geometry.area"):
         bgr.load("Lot --> s(geometry.area(2), 1, 1) A\nterminal A\n")
+
+
+def test_written_without_brackets_as_cga_allows():
+    source = (
+        "Lot --> case geometry.area < 100: s(geometry.area, geometry.nVertices, 1) Small\n"
+        "    | else: s(geometry.area, 1, 1) Large\n"
+        "terminal Small, Large\n"
+    )
+    assert measured(source, lot=(5, 5)) == {"Small": [25.0, 4.0, 1.0]}
+    assert measured(source, lot=(10, 20)) == {"Large": [200.0, 1.0, 1.0]}
+    with pytest.raises(bgr.BgrCheckError, match="only known while deriving a shape"):
+        bgr.load("attr a = geometry.area\nLot --> NIL\n")
