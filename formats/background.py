@@ -129,11 +129,16 @@ class _Forward(Sink):
 
 @contextlib.contextmanager
 def background(enabled: bool) -> Iterator[Writer | None]:
-    """A started :class:`Writer` (None when not ``enabled``), stopped when the block ends."""
+    """A started :class:`Writer`, stopped when the block ends; None when not ``enabled`` or
+    when no process can be started (the caller then writes in its own)."""
     if not enabled:
         yield None
         return
-    writer = Writer()
+    try:
+        writer = Writer()
+    except (OSError, RuntimeError, ValueError):  # no process to be had (a limit, a sandbox):
+        yield None  # the file is written here, as it always could be
+        return
     try:
         yield writer
     finally:

@@ -113,6 +113,15 @@ def test_the_writers_error_comes_back_here_and_leaves_nothing(street):
     assert litter(street) == []
 
 
+def test_no_process_to_be_had_means_writing_here(monkeypatch):
+    def refuse(self):
+        raise OSError(11, "Resource temporarily unavailable")
+
+    monkeypatch.setattr(Writer, "__init__", refuse)
+    with background(True) as writer:
+        assert writer is None
+
+
 def test_a_refused_output_is_reported_when_opened(street):
     writer = Writer()
     try:
