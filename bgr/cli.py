@@ -443,6 +443,9 @@ def build_parser() -> argparse.ArgumentParser:
         "--check", action="store_true", help="change nothing; exit 1 if a file is not formatted"
     )
     mode.add_argument("-w", "--write", action="store_true", help="rewrite the files in place")
+    from .cga import command as cga_command
+
+    cga_command.add_parser(commands)
     return parser
 
 
@@ -609,6 +612,12 @@ def _read(name: str) -> tuple[str, str]:
     if name == "-":
         return decode(sys.stdin.buffer.read(), "<stdin>"), "<stdin>"
     return read_source(name), name
+
+
+def _import_cga(args) -> int:
+    from .cga.command import run
+
+    return run(args)
 
 
 def cmd_check(args) -> int:
@@ -1065,6 +1074,7 @@ COMMANDS = {
     "retarget": cmd_retarget,
     "check": cmd_check,
     "fmt": cmd_fmt,
+    "import-cga": lambda args: _import_cga(args),
     "derive": cmd_derive,
     "render": cmd_render,
     "infer": cmd_infer,

@@ -139,7 +139,12 @@ CGA: list[tuple[str, str, str, str]] = [
     ("import", DIFFERENT, 'import "file.bgr" as name', "then `name.Rule`"),
     ("scope.sx, scope.sy, scope.sz", SAME, "scope.sx, scope.sy, scope.sz", ""),
     ("scope.tx, scope.ty, scope.tz", DIFFERENT, "scope.x, scope.y, scope.z", ""),
-    ("split.index, split.total, comp.index, comp.total", SAME, "split.index", "and the others"),
+    (
+        "split.index, split.total, comp.index, comp.total, comp.sel",
+        SAME,
+        "split.index",
+        "and the others",
+    ),
     ("@StartRule", DIFFERENT, "start Name", "or the first rule; the annotation is kept too"),
 ]
 
@@ -171,7 +176,10 @@ def table() -> str:
         "what bgr writes for each. **same**: the same name and meaning; **different**: "
         "another spelling; **partly**: some of its forms; **not yet**. Where bgr has the "
         "same name, its usage comes from bgr's operation registry. The semantics of each "
-        "are in [language.md](language.md); section 14 there is the short version.",
+        "are in [language.md](language.md); section 14 there is the short version. "
+        "`bgr import-cga` translates a CGA file with these equivalents and reports each "
+        "*not yet* it meets, at its line and column, leaving it out "
+        "([cli.md](cli.md#bgr-import-cga)).",
         "",
         f"{counts[SAME]} same, {counts[DIFFERENT]} different, {counts[PARTLY]} partly, "
         f"{counts[NOT_YET]} not yet, of {len(CGA)}.",

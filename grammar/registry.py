@@ -559,6 +559,10 @@ BUILTIN_NAMES: dict[str, str] = {
         "a top or bottom face)"
     ),
     "comp.right": "the corner at the face's right edge, as comp.left",
+    "comp.sel": (
+        'the selector that took the face in the enclosing comp ("front", "side", "top"...; '
+        '"face" for face(i)), as CGA\'s comp.sel'
+    ),
     "depth": "derivation depth of the shape",
     # CGA writes its geometry functions without brackets too: `case geometry.area < 100`
     "geometry.area": "geometry.area(), written bare as CGA allows",

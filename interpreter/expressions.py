@@ -53,6 +53,7 @@ class Context:
         "comp_total",
         "comp_left",
         "comp_right",
+        "comp_sel",
         "library",
     )
 
@@ -62,12 +63,13 @@ class Context:
         args: dict,
         stream,
         seed: int,
-        indices=(0, 1, 0, 1, 0.0, 0.0),
+        indices=(0, 1, 0, 1, 0.0, 0.0, ""),
         library=None,
     ) -> None:
-        """``indices``: split.index, split.total, comp.index, comp.total and the comp face's
-        left and right neighbour angles of the piece the shape came from; ``library``: the
-        derivation's unit meshes, which the geometry functions measure a mesh shape by."""
+        """``indices``: split.index, split.total, comp.index, comp.total, the comp face's left
+        and right neighbour angles and its selector, of the piece the shape came from;
+        ``library``: the derivation's unit meshes, which the geometry functions measure a mesh
+        shape by."""
         self.shape, self.args, self.stream, self.seed = shape, args, stream, seed
         self.library = library
         (
@@ -77,6 +79,7 @@ class Context:
             self.comp_total,
             self.comp_left,
             self.comp_right,
+            self.comp_sel,
         ) = indices
 
 
@@ -266,6 +269,8 @@ class Compiler:
             return lambda ctx: ctx.comp_left
         if name == "comp.right":
             return lambda ctx: ctx.comp_right
+        if name == "comp.sel":
+            return lambda ctx: ctx.comp_sel
         if name == "depth":
             return lambda ctx: ctx.shape.depth
         if name in _GEOMETRY_QUERIES:  # geometry.area written bare, as CGA allows

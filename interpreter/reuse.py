@@ -40,6 +40,7 @@ PLACED = {
     "comp.total",
     "comp.left",
     "comp.right",
+    "comp.sel",
     "depth",
     "seed",
 }

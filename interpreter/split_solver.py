@@ -188,7 +188,11 @@ def _repetitions(groups: list[Repeat], avail: float, float_out: float, length: f
     for extra in patterns:
         extra_len = sum(e * (a + f) for e, (a, f) in zip(extra, nominal, strict=True))
         k_star = (avail - float_out - extra_len) / per_rep
-        for k in {max(1, math.floor(k_star)), max(1, math.ceil(k_star))}:
+        # floating pieces outside the groups can take the whole length, so a group may vanish
+        # there, as in CGA (`{ ~w: Window | 0.25: Wall }* | ~w: Window` in w metres is one
+        # Window); with nothing else floating, every group keeps one repetition
+        least = 0 if float_out > EPS else 1
+        for k in {max(least, math.floor(k_star)), max(least, math.ceil(k_star))}:
             counts = [k + e for e in extra]
             fixed = sum(c * a for c, (a, _) in zip(counts, nominal, strict=True))
             flo = float_out + sum(c * f for c, (_, f) in zip(counts, nominal, strict=True))

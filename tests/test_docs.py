@@ -469,7 +469,7 @@ def _synopses() -> dict[tuple[int, str], set[str]]:
         line = text.count("\n", 0, m.start()) + 1
         command = None
         for row in m.group(1).split("\n"):
-            if start := re.match(r"bgr ([a-z]+) ", row):
+            if start := re.match(r"bgr ([a-z-]+) ", row):
                 command = start.group(1)
             elif not row.startswith(" "):
                 command = None

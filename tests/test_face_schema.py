@@ -281,16 +281,16 @@ def test_unroll_keeps_k_plus_one_when_nothing_ties():
 # ---- where the paper and split_solver part ------------------------------------------------------
 
 
-def test_paper_allows_zero_repetitions():
-    """The paper's k may be 0 when one repetition does not fit; LANGUAGE.md keeps at least one
-    while there is room.  (AB)*C, all stretch, A = B = 1, C = 10 (14 long), at 10.5: no (AB)
-    gives s = 1.05, one gives s = 0.875."""
+def test_paper_and_solver_allow_zero_repetitions():
+    """The paper's k may be 0 when one repetition does not fit, and so may the split solver's
+    where a floating piece outside the group takes the length (as CGA: issue 31).  (AB)*C, all
+    stretch, A = B = 1, C = 10 (14 long), at 10.5: no (AB) gives s = 1.05, one gives s = 0.875."""
     items = rewrite(list("ABABC"))
     widths, fixed = [1.0, 1.0, 1.0, 1.0, 10.0], [False] * 5
     counts, scale = retarget(items, widths, fixed, 10.5)
     assert counts == (0,) and scale == pytest.approx(1.05)
     theirs, their_scale = via_solver(items, widths, fixed, 10.5)
-    assert theirs == (1,) and their_scale == pytest.approx(0.875)
+    assert theirs == (0,) and their_scale == pytest.approx(1.05)
 
 
 def test_equal_groups_tie_at_the_original_length():

@@ -148,9 +148,13 @@ def test_retargeting_follows_the_papers_application_rule(src, pattern, factor):
     items = fs.rewrite(symbols)
     assert fs.to_text(items, symbols) == pattern
     width = sum(c.size for c in columns)
-    # the paper's rule with LANGUAGE.md's floor of one repetition per group (docs/inverse-schema.md)
+    # the paper's rule with the interpreter's floor (docs/inverse-schema.md)
     counts, scale = fs.retarget(
-        items, [c.size for c in columns], [c.fixed for c in columns], width * factor, minimum=1
+        items,
+        [c.size for c in columns],
+        [c.fixed for c in columns],
+        width * factor,
+        minimum=_floor(items, columns),
     )
 
     grammar = style(result)
@@ -537,3 +541,10 @@ def test_terminal_list_lists_each_lot_with_its_frame(tmp_path):
     np.testing.assert_allclose(
         lots[0]["axes"][2], [0, 0, -1], atol=1e-12
     )  # into the lot: north is -z
+
+
+def _floor(items, columns) -> int:
+    """The split solver's least repetitions per group: 0 where a stretchable column outside the
+    groups can take the length (as CGA), else 1 (docs/language.md, rule 3)."""
+    outside = [it.index for it in items if isinstance(it, fs.Sym)]
+    return 0 if any(not columns[i].fixed for i in outside) else 1

@@ -158,7 +158,11 @@ def test_flat_facade_retargets_by_the_papers_application_rule(name, factor):
             f"{name}: row {row} has no repeat group: {fs.to_text(items, symbols)}"
         )
         counts, scale = fs.retarget(
-            items, [c.size for c in columns], [c.fixed for c in columns], width * factor, minimum=1
+            items,
+            [c.size for c in columns],
+            [c.fixed for c in columns],
+            width * factor,
+            minimum=_floor(items, columns),
         )
         expected = [columns[i] for i in fs.expand(items, counts)]
         got = _columns_out(out, 1 if row < 0 else 2, row)
@@ -361,3 +365,10 @@ def test_schemas_do_not_depend_on_how_extrude_sets_the_scope():
     # the frame (and the glass it overlaps, one part) sits in the wall's window column
     assert "Win --> split(y) { ~0.942857143: Wall | ~0.08: Sill | ~1.6: W |" in text
     assert read_model(turned).dropped == 0
+
+
+def _floor(items, columns) -> int:
+    """The split solver's least repetitions per group: 0 where a stretchable column outside the
+    groups can take the length (as CGA), else 1 (docs/language.md, rule 3)."""
+    outside = [it.index for it in items if isinstance(it, fs.Sym)]
+    return 0 if any(not columns[i].fixed for i in outside) else 1

@@ -237,6 +237,7 @@ def comp(app, shape, step, args) -> bool:
     slants = [_slant(nrm) for _, nrm, _ in faces]
     taken = [False] * len(faces)
     for entry in step.block.entries:
+        selector = entry.key.name if isinstance(entry.key, n.Name) else "face"
         chosen = [
             i
             for i in range(len(faces))
@@ -248,7 +249,8 @@ def comp(app, shape, step, args) -> bool:
             rings, nrm, turns = faces[i]
             face = _face_shape(shape, rings, nrm)
             app.engine.count_shape(app.module, entry.pos)
-            app.piece(face, entry.body, comp=(j, len(chosen), *_left_right(rings, nrm, turns)))
+            corners = _left_right(rings, nrm, turns)
+            app.piece(face, entry.body, comp=(j, len(chosen), *corners, selector))
     return True
 
 

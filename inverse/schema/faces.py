@@ -201,8 +201,9 @@ def retarget(
     order too.
 
     ``minimum`` raises the floor of k: the paper lets a group vanish (k = 0) where one
-    repetition of every group does not fit; LANGUAGE.md section 6 (CGA) keeps at least one, which
-    is what the interpreter does and what ``minimum=1`` computes.
+    repetition of every group does not fit; the interpreter does too where a variable column
+    outside the groups takes the length (as CGA), and keeps at least one otherwise
+    (LANGUAGE.md section 6), which ``minimum=1`` computes.
 
     Where the paper is silent: with no variable column anywhere the scale means nothing, so the
     combination that fills most without overflowing wins (scale 1); when fixed columns alone

@@ -1,0 +1,395 @@
+"""CGA shape operations -> bgr steps, one small function per family.
+
+Each function takes the translator (for names, expressions, assets and warnings), the CGA call
+(its name, argument trees, block and meta) and the rest of the sequence after it, and returns the
+bgr steps plus whether it took the rest of the sequence in (``offset(-1, inside) A B`` becomes
+``offset(1) { inside: A B }``).  An operation bgr has no counterpart for is dropped with a warning
+when it only changes the shape (``alignScopeToGeometry``), or stands as ``NIL`` when it would
+have consumed it (``comp(e) { ... }``), so that what follows still derives.
+"""
+
+from __future__ import annotations
+
+import copy
+from typing import TYPE_CHECKING
+
+from lark import Tree
+
+from ..grammar import nodes as n
+from ..grammar.registry import OPERATIONS, PROJECTION_AXES_NAMES, SIZE, TEX_SIZE
+from .expressions import dotted, pos, unquote
+
+if TYPE_CHECKING:
+    from .translate import Translator
+
+Steps = tuple[list, bool]
+
+# bgr operations with CGA's name and arguments (their arguments are translated one by one)
+SAME = {
+    "t",
+    "s",
+    "r",
+    "center",
+    "extrude",
+    "taper",
+    "color",
+    "label",
+    "report",
+    "print",
+    "setupProjection",
+    "projectUV",
+    "tileUV",
+    "scaleUV",
+    "translateUV",
+    "rotateUV",
+    "normalizeUV",
+    "deleteUV",
+    "reverseNormals",
+    "texture",
+}
+ROOFS = {"roofGable": "gable", "roofHip": "hip", "roofPyramid": "pyramid", "roofShed": "shed"}
+PRIMITIVES = {
+    "primitiveCube": "cube",
+    "primitiveCylinder": "cylinder",
+    "primitiveSphere": "sphere",
+    "primitiveQuad": "quad",
+}
+BUILTIN_ASSETS = {"cube": "cube", "cylinder": "cylinder", "sphere": "sphere", "quad": "quad"}
+# operations that change the shape in a way bgr cannot yet: dropped, the shape goes on as it was
+DROPPED = {
+    "alignScopeToAxes",
+    "alignScopeToGeometry",
+    "rotateScope",
+    "convexify",
+    "cleanupGeometry",
+    "envelope",
+    "mirror",
+    "mirrorScope",
+    "trim",
+    "setPivot",
+    "setNormals",
+    "softenNormals",
+    "resetMaterial",
+    "rotate",
+    "translate",
+    "deleteHoles",
+    "modifyVertex",
+    "resetGeometry",
+    "splitAndSetbackPerimeter",
+    "insertAlongUV",
+    "scatter",
+    "shapeL",
+    "shapeU",
+    "shapeO",
+    "setback",
+    "innerRectangle",
+    "innerRect",
+    "splitArea",
+    "roofRamp",
+    "texture3D",
+    "primitiveDisk",
+    "primitiveTorus",
+    "tileUV3D",
+    "setMaterial",
+    "alignScopeToAxes3D",
+    "inline",
+    "comp",
+    "split",
+}
+SYMBOLS = {"x", "y", "z", "xy", "xz", "yz", "xyz"}
+TEXTURE_MAPS = {"material.colormap": "texture", "material.normalmap": "normalMap"}
+
+
+def operation(tr: Translator, name: str, args: list, block, meta, rest: list) -> Steps:
+    """The bgr steps for one CGA operation call."""
+    where = pos(meta)
+    if name in ("split", "comp") and block is not None:
+        return (
+            split(tr, args, block, meta) if name == "split" else comp(tr, args, block, meta)
+        ), False
+    if name == "offset":
+        return offset(tr, args, meta, rest)
+    if name in ROOFS:
+        return roof(tr, name, args, meta), False
+    if name in PRIMITIVES:
+        steps: list = []
+        if len(args) == 3:
+            steps.append(n.Operation("s", [tr.expr(a) for a in args], pos=where))
+        return steps + [n.Operation("i", [n.Name(PRIMITIVES[name])], pos=where)], False
+    if name == "i":
+        return insert(tr, args, meta, rest)
+    if name == "set":
+        return set_value(tr, args, meta), False
+    if name == "texture":
+        return texture(tr, "texture", args, meta), False
+    if name in SAME:
+        return same(tr, name, args, meta), False
+    if name == "convexify" and _is_comp_f(rest[0] if rest else None):
+        whole = _only_all(rest[0])
+        if whole is not None:
+            # `convexify comp(f) { all: A }`: without convexify the shape is one part, A's
+            tr.warn(
+                meta,
+                "convexify() is not in bgr yet: the shape goes whole to its "
+                "comp(f) { all: ... } (exact for a convex shape)",
+            )
+            return tr.steps(list(whole.children) + rest[1:]), True
+    if name in DROPPED or name in ("split", "comp"):
+        if block is not None:
+            tr.warn(
+                meta,
+                f"{name}() is not in bgr yet; its shape is dropped (NIL)",
+                "the parts it would make are missing from the translation",
+            )
+            return [n.Nil(pos=where)], True
+        tr.warn(meta, f"{name}() is not in bgr yet; it is left out and the shape goes on as it was")
+        return [], False
+    tr.warn(meta, f"unknown operation '{name}'; it is left out")
+    return [], False
+
+
+def same(tr: Translator, name: str, args: list, meta) -> list:
+    op = OPERATIONS[name]
+    out: list = []
+    least, most = op.arities()[0][0], max(m for _, m in op.arities())
+    if (
+        name == "color"
+        and len(args) == 1
+        and isinstance(args[0], Tree)
+        and args[0].data == "number"
+    ):
+        tr.warn(meta, "color() of one number is read as a grey: color(v, v, v)")
+        args = args * 3
+    if name == "color" and len(args) == 4:
+        tr.warn(meta, "color()'s alpha is left out (set material.opacity is not in bgr yet)")
+        args = args[:3]
+    if name == "r" and args and _word(args[0]) in ("scopeCenter", "scopeOrigin"):
+        if _word(args[0]) == "scopeCenter":
+            tr.warn(meta, "r(scopeCenter, ...) turns about the scope's origin in bgr")
+        args = args[1:]
+    word = _word(args[0]) if args else None
+    if name == "extrude" and word is not None and word.startswith(("world.", "face.", "vertex.")):
+        if word not in ("world.up", "face.normal"):
+            tr.warn(meta, f"extrude({word}, ...) is extruded along world.up")
+        out.append(n.Name("world.up" if word != "face.normal" else "face.normal"))
+        args = args[1:]
+    if len(args) + len(out) > most:
+        tr.warn(meta, f"{name}() takes at most {most} arguments in bgr; the others are left out")
+        args = args[: most - len(out)]
+    sig = next((g for g in op.signatures if len(g) >= len(args) + len(out)), op.signatures[-1])
+    for a in args:
+        arg = tr.op_arg(a, symbols=name in ("center", "setupProjection", "normalizeUV"))
+        kind = op.param(sig, len(out)).kind
+        if isinstance(arg, n.Relative) and kind not in (SIZE, TEX_SIZE):
+            arg = _absolute(tr, name, arg, out, a)
+        out.append(arg)
+    if len(out) < least:
+        tr.warn(meta, f"{name}() needs {least} arguments in bgr; it is left out")
+        return []
+    return [n.Operation(name, out, pos=pos(meta))]
+
+
+def _absolute(tr: Translator, name: str, arg: n.Relative, before: list, t) -> n.Expr:
+    """A ``'f`` where bgr takes metres: setupProjection's offsets are fractions of the scope
+    along the projection's axes (``'8`` on ``scope.xz``'s v is 8 * scope.sz); elsewhere the
+    ``'`` is dropped."""
+    if name == "setupProjection" and len(before) in (4, 5) and isinstance(before[1], n.Name):
+        axes = before[1].name.split(".")[-1]
+        axis = axes[len(before) - 4]
+        return n.Binary("*", arg.expr, n.Name(f"scope.s{axis}"))
+    tr.warn(
+        getattr(t, "meta", None),
+        f"a relative ' size is not allowed there in {name}(); it is read as metres",
+    )
+    return arg.expr
+
+
+def split(tr: Translator, args: list, block: Tree, meta) -> list:
+    axis = _word(args[0]) if args else None
+    if axis not in ("x", "y", "z"):
+        tr.warn(meta, "split() of this kind is not in bgr yet; its shape is dropped (NIL)")
+        return [n.Nil(pos=pos(meta))]
+    if len(args) > 1:
+        tr.warn(meta, "split()'s adjust/unitSpace arguments are left out")
+    return _with_block(tr, "split", [n.Name(axis)], tr.block(block, "split"), meta)
+
+
+COMP_SELECTORS = {
+    "front",
+    "back",
+    "left",
+    "right",
+    "side",
+    "top",
+    "bottom",
+    "vertical",
+    "horizontal",
+    "aslant",
+    "all",
+}
+
+
+def comp(tr: Translator, args: list, block: Tree, meta) -> list:
+    kind = _word(args[0]) if args else None
+    if kind != "f":
+        tr.warn(
+            meta,
+            f"comp({kind}) is not in bgr yet (faces only); its shape is dropped (NIL)",
+            "the parts it would make are missing from the translation",
+        )
+        return [n.Nil(pos=pos(meta))]
+    return _with_block(tr, "comp", [n.Name("f")], tr.block(block, "comp"), meta)
+
+
+def _with_block(tr: Translator, name: str, args: list, block: n.Block | None, meta) -> list:
+    if block is None:  # each entry was left out (and reported): nothing is made of the shape
+        return [n.Nil(pos=pos(meta))]
+    return [n.Operation(name, args, block, pos=pos(meta))]
+
+
+def offset(tr: Translator, args: list, meta, rest: list) -> Steps:
+    """CGA's ``offset(d)`` keeps the face with an inner and a border part that a later
+    ``comp(f) { inside: .. | border: .. }`` selects; ``offset(d, inside)`` keeps only one part.
+    bgr's offset takes the block at once, with the opposite sign (a positive distance shrinks)."""
+    where = pos(meta)
+    if not args:
+        tr.warn(meta, "offset() needs a distance; it is left out")
+        return [], False
+    distance = negated(tr.expr(args[0]))
+    part = _word(args[1]) if len(args) > 1 else "all"
+    if part in ("inside", "border"):
+        body = tr.sequence_of(rest)
+        block = n.Block([n.Entry("abs", n.Name(part), body)])
+        return [n.Operation("offset", [distance], block, pos=where)], True
+    follow = rest[0] if rest else None
+    if follow is not None and _is_comp_f(follow):
+        block = tr.block(follow.children[-1], "offset")
+        return _with_block(tr, "offset", [distance], block, meta), True
+    tr.warn(
+        meta,
+        "offset() without a comp(f) after it: the rest of the rule runs on the inside "
+        "and the border apart",
+    )
+    body = tr.sequence_of(rest)
+    block = n.Block(
+        [
+            n.Entry("abs", n.Name("inside"), body),
+            n.Entry("abs", n.Name("border"), copy.deepcopy(body)),
+        ]
+    )
+    return [n.Operation("offset", [distance], block, pos=where)], True
+
+
+def negated(e: n.Expr) -> n.Expr:
+    """``-e``, written simply: ``-0.8`` is ``0.8``, ``-(-d)`` is ``d``."""
+    if isinstance(e, n.Number):
+        return n.Number(-e.value)
+    if isinstance(e, n.Unary) and e.op == "-":
+        return e.operand
+    return n.Unary("-", e)
+
+
+def _is_comp_f(t) -> bool:
+    if not (isinstance(t, Tree) and t.data == "call"):
+        return False
+    name = dotted(t.children[0])
+    args = [] if t.children[1] is None else t.children[1].children
+    return name == "comp" and t.children[2] is not None and bool(args) and _word(args[0]) == "f"
+
+
+def _only_all(t: Tree):
+    """The sequence of a ``comp(f) { all: ... }`` block with that one entry, else None."""
+    block = t.children[-1]
+    assert isinstance(block, Tree)  # a comp(f) with a block: _is_comp_f said so
+    entries = block.children[1].children
+    if (
+        len(entries) == 1
+        and entries[0].data == "keyed"
+        and _word(entries[0].children[0].children[0]) == "all"
+    ):
+        return entries[0].children[1]
+    return None
+
+
+def roof(tr: Translator, name: str, args: list, meta) -> list:
+    out: list = [n.Name(ROOFS[name])]
+    if args:
+        out.append(tr.expr(args[0]))
+    if name in ("roofGable", "roofHip") and len(args) > 1:
+        out.append(tr.expr(args[1]))
+    extra = args[3:] if name == "roofGable" else args[2:] if name == "roofHip" else args[1:]
+    if name == "roofGable" and len(args) > 2 and not _zero(args[2]):
+        tr.warn(meta, "roofGable()'s second overhang is not in bgr: the first is used for both")
+    if any(not _zero(a) and _word(a) != "false" for a in extra):
+        tr.warn(meta, f"{name}()'s further arguments are left out")
+    return [n.Operation("roof", out, pos=pos(meta))]
+
+
+def insert(tr: Translator, args: list, meta, rest: list) -> Steps:
+    where = pos(meta)
+    if not args:
+        tr.warn(meta, "i() needs a geometry; it is left out")
+        return [], False
+    geometry = tr.asset_of(args[0], meta)
+    if geometry is not None:
+        return [n.Operation("i", [geometry], pos=where)], False
+    # a path computed at derive time (a rule parameter): one branch per asset the file names
+    return tr.dispatch_insert(args[0], meta, rest), True
+
+
+def texture(tr: Translator, op: str, args: list, meta) -> list:
+    if not args:
+        return []
+    path = tr.texture_path(args[0], meta)
+    return [] if path is None else [n.Operation(op, [path], pos=pos(meta))]
+
+
+def set_value(tr: Translator, args: list, meta) -> list:
+    if len(args) != 2:
+        tr.warn(meta, "set() takes a name and a value; it is left out")
+        return []
+    target = _word(args[0])
+    if target == "material.name":
+        return [n.Operation("material", [tr.expr(args[1])], pos=pos(meta))]
+    if target in TEXTURE_MAPS:
+        return texture(tr, TEXTURE_MAPS[target], args[1:], meta)
+    if target == "material.color.rgb" or target == "material.color":
+        return [n.Operation("color", [tr.expr(args[1])], pos=pos(meta))]
+    attr = tr.attr_name(target) if target else None
+    if attr is None:
+        tr.warn(
+            meta, f"set({target}, ...) is not in bgr yet (attrs of this file only); it is left out"
+        )
+        return []
+    return [n.Operation("set", [n.Name(attr), tr.expr(args[1])], pos=pos(meta))]
+
+
+def _word(t) -> str | None:
+    """The bare name an argument is (``x``, ``world.up``, ``inside``), or None."""
+    if isinstance(t, Tree) and t.data == "name":
+        return dotted(t.children[0])
+    if isinstance(t, Tree) and t.data == "dotted":
+        return dotted(t)
+    if isinstance(t, Tree) and t.data in ("true", "false"):
+        return t.data
+    return None
+
+
+def _zero(t) -> bool:
+    return isinstance(t, Tree) and t.data == "number" and float(str(t.children[0])) == 0.0
+
+
+def literal_string(t) -> str | None:
+    if isinstance(t, Tree) and t.data == "string":
+        return unquote(t.children[0])
+    return None
+
+
+def is_symbol_arg(t, projection: bool) -> str | None:
+    """A bare word bgr takes as a symbol: an axis set, or a projection's axes (``scope.xy``)."""
+    word = _word(t)
+    if word in SYMBOLS or (projection and word in PROJECTION_AXES_NAMES):
+        return word
+    if word in ("uv", "uvUniform", "u", "v", "separatePerFace", "collectiveAllFaces"):
+        return word
+    return None

@@ -1,0 +1,279 @@
+"""bgr import-cga: CityEngine CGA rule files translated into grammars that check and derive.
+
+The CGA snippets here are written for these tests in CGA's documented syntax; the real rule
+files from Esri's public rule packages are read from ../shared/data/cga when it is there.
+"""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+import bgr
+from bgr.cga.files import translate_file
+from bgr.cga.parse import parse
+from bgr.grammar.errors import BgrError
+
+SHARED_CGA = Path(__file__).resolve().parents[2] / "shared" / "data" / "cga"
+
+
+def _import(tmp_path: Path, text: str, name: str = "rules.cga"):
+    src = tmp_path / name
+    src.write_text(text, encoding="utf-8")
+    out = tmp_path / "out" / (src.stem + ".bgr")
+    out.parent.mkdir(exist_ok=True)
+    result = translate_file(src, out)
+    for path, body in result.outputs.items():
+        path.write_text(body, encoding="utf-8")
+    return out, result
+
+
+def _derive(out: Path, **kw):
+    grammar = bgr.load(out)
+    return bgr.derive(grammar, lot=kw.pop("lot", (40.0, 30.0)), **kw)
+
+
+def _labels(result) -> dict[str, int]:
+    counts: dict[str, int] = {}
+    for label in result.terminals.label:
+        counts[label] = counts.get(label, 0) + 1
+    return counts
+
+
+def test_rules_cases_and_choices_translate_and_derive(tmp_path):
+    out, result = _import(
+        tmp_path,
+        """version "2014.0"
+attr height = 12
+const floorH = case height > 10: 3 else: 4
+@StartRule
+Lot --> extrude(height) comp(f) { top: Roof | side: Facade }
+Facade --> split(y) { ~floorH: Floor }*
+Floor -->
+    case split.index == 0 && !(scope.sx < 1): Ground
+    case split.index > 0 || false: 50%: Upper else: Upper
+    else: NIL
+Ground --> color("#aa0000")
+Upper --> color(pow(0.5, 1), 0.5, 0.5)
+Roof --> Roof.
+""",
+    )
+    assert result.warnings == []
+    text = out.read_text()
+    assert "start Lot" in text and "terminal RoofLeaf" in text
+    assert "and not scope.sx < 1" in text and "0.5 ** 1" in text
+    assert "height > 10 ? 3 : 4" in text
+    # the case branch that is a stochastic choice became a rule of its own
+    assert "Floor_1 -->" in text and "50%: Upper" in text
+    labels = _labels(_derive(out))
+    assert labels["Ground"] == 4  # one ground floor per side
+    assert labels["Upper"] == 4 * 3  # 12 m of 3 m floors: three more per side
+    assert labels["RoofLeaf"] == 1
+
+
+def test_overloaded_rules_get_a_name_each(tmp_path):
+    out, result = _import(
+        tmp_path,
+        """Lot --> Box(3) Box
+Box(h) --> extrude(h) Solid
+Box --> extrude(1) Solid
+Solid --> color(0, 0, 1)
+""",
+    )
+    assert result.warnings == []
+    text = out.read_text()
+    assert "Box --> extrude(1) Solid" in text and "Box_1(h) --> extrude(h) Solid" in text
+    assert "Lot --> Box_1(3) Box" in text
+    heights = sorted(float(h) for h in _derive(out).terminals.size[:, 1])
+    assert heights == pytest.approx([1.0, 3.0])
+
+
+def test_offset_sign_and_selectors(tmp_path):
+    out, result = _import(
+        tmp_path,
+        """Lot --> offset(-2) comp(f) { inside: Inner | border: Frame }
+Inner --> offset(-1, inside) Core
+Core --> color(1, 1, 1)
+Frame --> color(0, 0, 0)
+""",
+    )
+    assert result.warnings == []
+    text = out.read_text()
+    assert "offset(2) { inside: Inner | border: Frame }" in text
+    assert "offset(1) { inside: Core }" in text
+    derived = _derive(out)
+    core = [k for k, label in enumerate(derived.terminals.label) if label == "Core"]
+    assert len(core) == 1
+    assert derived.terminals.size[core[0], 0] == pytest.approx(40 - 2 * 3)
+
+
+def test_an_attr_that_reads_the_shape_is_set_when_the_start_rule_begins(tmp_path):
+    out, result = _import(
+        tmp_path,
+        """attr area = geometry.area
+attr height = area / 100
+Lot --> extrude(height) report("h", height)
+""",
+    )
+    assert [w.line for w in result.warnings] == [1, 2]
+    assert all("reads the shape" in w.message for w in result.warnings)
+    derived = _derive(out)
+    assert derived.reports[0]["reports"]["h"]["sum"] == pytest.approx(40 * 30 / 100)
+
+
+def test_what_bgr_lacks_is_reported_at_its_place_and_left_out(tmp_path):
+    out, result = _import(
+        tmp_path,
+        """Lot --> alignScopeToAxes(y)
+    extrude(10)
+    comp(f) { front: Front | side: Side }
+Front --> comp(e) { all: Edge }
+Side --> envelope(world.up, 1, 1, 45, 1, 45) color(case inside(all): 1 else: 0, 0, 0)
+Edge --> color(1, 0, 0)
+""",
+    )
+    found = {(w.line, w.column): w.message for w in result.warnings}
+    assert "alignScopeToAxes" in found[(1, 9)]
+    assert "comp(e)" in found[(4, 11)]
+    assert "envelope" in found[(5, 10)]
+    assert any(line == 5 and "inside" in m for (line, _), m in found.items())
+    labels = _labels(_derive(out))
+    assert "Edge" not in labels and labels["Side"] == 3  # comp(e) stood as NIL
+
+
+def test_assets_beside_the_file_and_missing_ones(tmp_path):
+    assets = tmp_path / "assets" / "parts"
+    assets.mkdir(parents=True)
+    (assets / "post.obj").write_text(
+        "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 1\nf 1 2 3\nf 1 3 4\n", encoding="utf-8"
+    )
+    (tmp_path / "rules").mkdir()
+    out, result = _import(
+        tmp_path,
+        """Lot --> [ i("parts/post.obj") Post ] [ t(5, 0, 0) i("parts/gone.obj") Gone ]
+    i("builtin:cube") Cube
+""",
+        name="rules/posts.cga",
+    )
+    assert [w.message for w in result.warnings if "gone.obj" in w.message]
+    text = out.read_text()
+    assert 'asset post = "../assets/parts/post.obj"' in text
+    assert "i(post) Post" in text and "i(cube) Gone" in text
+    grammar = bgr.load(out, allow_paths=[tmp_path / "assets"])
+    labels = _labels(bgr.derive(grammar, lot=(4.0, 4.0)))
+    assert labels == {"Post": 1, "Gone": 1, "Cube": 1}
+
+
+def test_comments_are_kept(tmp_path):
+    out, _ = _import(
+        tmp_path,
+        """/* A file header,
+ * two lines. */
+// the start
+Lot --> extrude(3) # and a trailing note
+""",
+    )
+    text = out.read_text()
+    assert "# A file header," in text and "# two lines." in text
+    assert "# the start" in text and "# and a trailing note" in text
+    assert text.index("# the start") < text.index("Lot -->")
+
+
+def test_a_floating_repeat_may_vanish_where_a_floating_piece_fills_the_scope(tmp_path):
+    # Candler's Windows(1): the group of window and divider gets no repetition, one window
+    out, _ = _import(
+        tmp_path,
+        """Lot --> extrude(5) comp(f) { front: Windows(1) }
+Windows(n) --> split(x) { { ~scope.sx/n: Window | 0.25: Wall }* | ~scope.sx/n: Window }
+Window --> color(0, 0, 1)
+Wall --> color(1, 1, 1)
+""",
+    )
+    assert _labels(_derive(out)) == {"Window": 1}
+    # a group with nothing else floating beside it keeps its one repetition
+    g = bgr.load("version 1\nterminal A\nLot --> split(x) { { ~30: A }* }")
+    assert len(bgr.derive(g, lot=(4.0, 4.0)).terminals) == 1
+
+
+def test_syntax_errors_name_the_place(tmp_path):
+    src = tmp_path / "bad.cga"
+    src.write_text("Lot --> extrude(3\nA --> B\n", encoding="utf-8")
+    with pytest.raises(BgrError) as e:
+        translate_file(src, tmp_path / "bad.bgr")
+    d = e.value.diagnostics[0]
+    assert (d.path, d.line) == (str(src), 2)
+    assert "unexpected" in d.message
+
+
+def test_cli_writes_the_grammar_and_strict_writes_nothing(tmp_path):
+    src = tmp_path / "box.cga"
+    src.write_text("Lot --> extrude(3) rotateScope(0, 90, 0) Box\nBox --> color(1,0,0)\n")
+    out = tmp_path / "box.bgr"
+    cmd = [sys.executable, "-m", "bgr", "import-cga", str(src)]
+    strict = subprocess.run([*cmd, "-o", str(out), "--strict"], capture_output=True, text=True)
+    assert strict.returncode == 1 and not out.exists()
+    assert f"{src}:1:20: error: rotateScope() is not in bgr yet" in strict.stderr
+    done = subprocess.run([*cmd, "-o", str(out)], capture_output=True, text=True)
+    assert done.returncode == 0, done.stderr
+    assert f"{src}:1:20: warning:" in done.stderr and "1 construct not translated" in done.stderr
+    assert "Traceback" not in done.stderr + strict.stderr
+    check = subprocess.run([sys.executable, "-m", "bgr", "check", str(out)], capture_output=True)
+    assert check.returncode == 0
+    refused = subprocess.run([*cmd[:-1], str(out)], capture_output=True, text=True)
+    assert refused.returncode == 1 and "not a .cga file" in refused.stderr
+
+
+@settings(max_examples=150, deadline=None)
+@given(
+    st.text(
+        alphabet=st.sampled_from(list("Lot-->(){}[]|:~'*%=\"#/ \n.,@!&1x_caseelsNIL")), max_size=80
+    )
+)
+def test_any_text_parses_or_is_a_located_error(text):
+    try:
+        parse(text, "fuzz.cga")
+    except BgrError as e:
+        assert e.diagnostics[0].path == "fuzz.cga"
+
+
+@pytest.mark.skipif(not SHARED_CGA.is_dir(), reason="needs ../shared/data/cga")
+@pytest.mark.parametrize(
+    "name", sorted(p.name for p in SHARED_CGA.glob("*.cga")) if SHARED_CGA.is_dir() else []
+)
+def test_esri_rule_files_import_and_derive_on_a_40_by_30_lot(tmp_path, name):
+    out = tmp_path / (Path(name).stem.split("__")[-1] + ".bgr")
+    result = translate_file(SHARED_CGA / name, out)
+    for path, body in result.outputs.items():
+        path.write_text(body, encoding="utf-8")
+    grammar = bgr.load(out)
+    derived = bgr.derive(grammar, lot=(40.0, 30.0))
+    assert len(derived) > 0, name
+    json.dumps([w.message for w in result.warnings])  # the report is plain text
+
+
+def test_comp_sel_names_the_selector_that_took_the_face(tmp_path):
+    # CGA's comp.sel, as Candler's SubLedge reads it: the ledge is widened toward its corner
+    out, result = _import(
+        tmp_path,
+        """Lot --> extrude(3) comp(f) { front: Face | left: Face | right: Face | top: Face }
+Face --> case comp.sel == "left": L
+    case comp.sel == "right": R
+    else: Other
+L --> color(1, 0, 0)
+R --> color(0, 1, 0)
+Other --> color(0, 0, 1)
+""",
+    )
+    assert result.warnings == []
+    assert _labels(_derive(out)) == {"L": 1, "R": 1, "Other": 2}
+    grammar = bgr.load(
+        "version 1\nLot --> extrude(3) comp(f) { side: A | face(5): A }\nA --> label(comp.sel)"
+    )
+    labels = list(bgr.derive(grammar, lot=(4.0, 4.0)).terminals.label)
+    assert labels == ["side"] * 4 + ["face"]
