@@ -16,7 +16,14 @@ from typing import TYPE_CHECKING
 from lark import Tree
 
 from ..grammar import nodes as n
-from ..grammar.registry import OPERATIONS, PROJECTION_AXES_NAMES, SIZE, TEX_SIZE
+from ..grammar.registry import (
+    NUMBER_OR_WORD,
+    OPERATIONS,
+    PROJECTION_AXES_NAMES,
+    SIZE,
+    TEX_SIZE,
+    UP_AXES,
+)
 from .expressions import dotted, pos, unquote
 
 if TYPE_CHECKING:
@@ -46,7 +53,14 @@ SAME = {
     "deleteUV",
     "reverseNormals",
     "texture",
+    "rotateScope",
+    "alignScopeToAxes",
+    "alignScopeToGeometry",
 }
+# operations some of whose arguments are bare words
+WORDS_TAKEN = (
+    "center", "setupProjection", "normalizeUV", "alignScopeToAxes", "alignScopeToGeometry",
+)  # fmt: skip
 ROOFS = {"roofGable": "gable", "roofHip": "hip", "roofPyramid": "pyramid", "roofShed": "shed"}
 PRIMITIVES = {
     "primitiveCube": "cube",
@@ -57,9 +71,6 @@ PRIMITIVES = {
 BUILTIN_ASSETS = {"cube": "cube", "cylinder": "cylinder", "sphere": "sphere", "quad": "quad"}
 # operations that change the shape in a way bgr cannot yet: dropped, the shape goes on as it was
 DROPPED = {
-    "alignScopeToAxes",
-    "alignScopeToGeometry",
-    "rotateScope",
     "convexify",
     "cleanupGeometry",
     "envelope",
@@ -124,16 +135,6 @@ def operation(tr: Translator, name: str, args: list, block, meta, rest: list) ->
         return texture(tr, "texture", args, meta), False
     if name in SAME:
         return same(tr, name, args, meta), False
-    if name == "convexify" and _is_comp_f(rest[0] if rest else None):
-        whole = _only_all(rest[0])
-        if whole is not None:
-            # `convexify comp(f) { all: A }`: without convexify the shape is one part, A's
-            tr.warn(
-                meta,
-                "convexify() is not in bgr yet: the shape goes whole to its "
-                "comp(f) { all: ... } (exact for a convex shape)",
-            )
-            return tr.steps(list(whole.children) + rest[1:]), True
     if name in DROPPED or name in ("split", "comp"):
         if block is not None:
             tr.warn(
@@ -178,7 +179,7 @@ def same(tr: Translator, name: str, args: list, meta) -> list:
         args = args[: most - len(out)]
     sig = next((g for g in op.signatures if len(g) >= len(args) + len(out)), op.signatures[-1])
     for a in args:
-        arg = tr.op_arg(a, symbols=name in ("center", "setupProjection", "normalizeUV"))
+        arg = tr.op_arg(a, symbols=name in WORDS_TAKEN)
         kind = op.param(sig, len(out)).kind
         if isinstance(arg, n.Relative) and kind not in (SIZE, TEX_SIZE):
             arg = _absolute(tr, name, arg, out, a)
@@ -297,20 +298,6 @@ def _is_comp_f(t) -> bool:
     return name == "comp" and t.children[2] is not None and bool(args) and _word(args[0]) == "f"
 
 
-def _only_all(t: Tree):
-    """The sequence of a ``comp(f) { all: ... }`` block with that one entry, else None."""
-    block = t.children[-1]
-    assert isinstance(block, Tree)  # a comp(f) with a block: _is_comp_f said so
-    entries = block.children[1].children
-    if (
-        len(entries) == 1
-        and entries[0].data == "keyed"
-        and _word(entries[0].children[0].children[0]) == "all"
-    ):
-        return entries[0].children[1]
-    return None
-
-
 def roof(tr: Translator, name: str, args: list, meta) -> list:
     out: list = [n.Name(ROOFS[name])]
     if args:
@@ -391,5 +378,7 @@ def is_symbol_arg(t, projection: bool) -> str | None:
     if word in SYMBOLS or (projection and word in PROJECTION_AXES_NAMES):
         return word
     if word in ("uv", "uvUniform", "u", "v", "separatePerFace", "collectiveAllFaces"):
+        return word
+    if word in UP_AXES or any(word in words for words in NUMBER_OR_WORD.values()):
         return word
     return None

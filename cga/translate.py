@@ -31,9 +31,9 @@ from ..grammar.errors import Diagnostic, source_line
 from ..grammar.registry import BUILTIN_NAMES, BUILTINS, KEYWORDS, OPERATIONS
 from . import operations as ops
 from .expressions import Expressions, dotted, pos, unquote
+from .start import At, shape_attrs
 
 GEOMETRY_FILES = (".obj", ".glb", ".gltf", ".fbx", ".dae", ".ply", ".stl", ".3ds")
-_SHAPE_NAMES = ("scope.", "split.", "comp.", "geometry.", "initialShape.")
 EMPTY = "t"  # a step that changes nothing: a sequence CGA leaves empty keeps its shape as a leaf
 
 
@@ -48,6 +48,10 @@ def ascii_name(name: str) -> str:
 
 def _nothing() -> n.Sequence:
     return n.Sequence([n.Operation(EMPTY, [n.Number(0.0)] * 3)])
+
+
+_PLAIN_BUILTINS = {k for k in BUILTIN_NAMES if "." not in k}
+_ZERO_ARG_OPS = set(ops.SAME) | set(ops.DROPPED) | set(ops.PRIMITIVES) | {"NIL"}
 
 
 class Translator:
@@ -245,7 +249,7 @@ class Translator:
                 self.extra = []
             notes = []
         self.drop_notes(notes, "the end of the file")
-        items = self.shape_attrs(items, attrs, consts)
+        items = shape_attrs(self, items, attrs, consts)
         # the declarations bgr wants up front stand on the version's line, so that comments
         # keep their places around them
         head = items[0].pos if items[0].pos.line else n.Pos(1, 1, 1, 1)
@@ -262,7 +266,7 @@ class Translator:
     def drop_notes(self, notes: list, what: str) -> None:
         for note in notes:
             self.warn(
-                _Meta(note.pos),
+                At(note.pos),
                 f"annotation @{note.name} on {what} is "
                 "left out (bgr keeps annotations on attrs and rules)",
             )
@@ -583,76 +587,6 @@ class Translator:
                 out.add(text)
         return out
 
-    # ---- attrs that read the shape -------------------------------------------------------------
-    def shape_attrs(self, items: list, attrs: list[n.Attr], consts: list[n.Const]) -> list:
-        """Attrs and consts whose value reads the shape: a plain default, then ``set()`` when the
-        start rule begins, in an order where each comes after what it reads."""
-        funcs = {f.name: f.body for f in items if isinstance(f, n.Func)}
-        values = {a.name: a.value for a in attrs} | {c.name: c.value for c in consts}
-        memo: dict[str, bool] = {}
-
-        def reads_shape(e, seen=frozenset()) -> bool:
-            for x in _walk(e):
-                if isinstance(x, n.Name) and x.name.startswith(_SHAPE_NAMES):
-                    return True
-                if isinstance(x, n.Call) and x.name.startswith("geometry."):
-                    return True
-                ref = x.name if isinstance(x, (n.Name, n.Call)) else None
-                if ref is None or ref in seen:
-                    continue
-                if ref not in memo and (ref in values or ref in funcs):
-                    target = values.get(ref, funcs.get(ref))
-                    memo[ref] = reads_shape(target, seen | {ref})
-                if memo.get(ref):
-                    return True
-            return False
-
-        moving = [d for d in attrs + consts if reads_shape(d.value)]
-        if not moving:
-            return items
-        sets = []
-        for d in _ordered(moving, funcs):
-            sets.append(n.Operation("set", [n.Name(d.name), d.value]))
-            self.warn(
-                _Meta(d.pos),
-                f"'{d.name}' reads the shape: bgr computes it when the start "
-                "rule begins (set()), so --set does not override it",
-            )
-        out = []
-        for item in items:
-            if any(item is d for d in moving):
-                item = n.Attr(
-                    item.name,
-                    _placeholder(item.value),
-                    pos=item.pos,
-                    annotations=getattr(item, "annotations", None)
-                    or ([] if isinstance(item, n.Attr) else [n.Annotation("Hidden")]),
-                )
-            out.append(item)
-        return self.prepend_to_start(out, sets)
-
-    def prepend_to_start(self, items: list, steps: list) -> list:
-        rules = [r for r in items if isinstance(r, n.Rule)]
-        if not rules:
-            return items
-        start = next((r for r in rules if r.name == self.start), rules[0])
-        if isinstance(start.body, n.Sequence):
-            start.body.steps[:0] = steps
-            return items
-        inner = n.Rule(self.fresh(start.name + "Main", OPERATIONS), [], start.body, pos=start.pos)
-        start.body = n.Sequence(steps + [n.Successor(inner.name)])
-        at = items.index(start)
-        return items[: at + 1] + [inner] + items[at + 1 :]
-
-
-_PLAIN_BUILTINS = {k for k in BUILTIN_NAMES if "." not in k}
-_ZERO_ARG_OPS = set(ops.SAME) | set(ops.DROPPED) | set(ops.PRIMITIVES) | {"NIL"}
-
-
-class _Meta:
-    def __init__(self, p: n.Pos) -> None:
-        self.line, self.column = p.line, p.column
-
 
 def ops_key(e: n.Expr) -> str:
     return e.name if isinstance(e, n.Name) else repr(e)
@@ -670,61 +604,3 @@ def _on_attr(note: n.Annotation) -> bool:
 def _on_rule(note: n.Annotation) -> bool:
     spec = SPECS.get(note.name)
     return spec is None or "rule" in spec.targets
-
-
-def _walk(e):
-    stack = [e]
-    while stack:
-        x = stack.pop()
-        yield x
-        if isinstance(x, n.Binary):
-            stack += (x.left, x.right)
-        elif isinstance(x, n.Unary):
-            stack.append(x.operand)
-        elif isinstance(x, n.Ternary):
-            stack += (x.cond, x.then, x.otherwise)
-        elif isinstance(x, n.Call):
-            stack += x.args
-
-
-def _placeholder(e: n.Expr) -> n.Expr:
-    """A literal of the type ``e`` seems to have: its first literal leaf's, else 0."""
-    for x in _walk(e):
-        if isinstance(x, n.Ternary):
-            continue
-        if isinstance(x, n.String):
-            return n.String("")
-        if isinstance(x, n.Bool):
-            return n.Bool(False)
-        if isinstance(x, (n.Number, n.Binary, n.Unary)):
-            return n.Number(0.0)
-    return n.Number(0.0)
-
-
-def _ordered(decls: list, funcs: dict) -> list:
-    """Declarations in file order, each moved after those it reads (through functions too)."""
-    names = {d.name for d in decls}
-    done: list = []
-    placed: set[str] = set()
-
-    def reads(e, seen: set) -> set[str]:
-        out = set()
-        for x in _walk(e):
-            if isinstance(x, n.Name) and x.name in names:
-                out.add(x.name)
-            elif isinstance(x, n.Call) and x.name in funcs and x.name not in seen:
-                seen.add(x.name)
-                out |= reads(funcs[x.name], seen)
-        return out
-
-    def place(d, stack=()):
-        if d.name in placed or d.name in stack:
-            return
-        for name in sorted(reads(d.value, set())):
-            place(next(o for o in decls if o.name == name), (*stack, d.name))
-        placed.add(d.name)
-        done.append(d)
-
-    for d in decls:
-        place(d)
-    return done

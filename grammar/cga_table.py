@@ -19,8 +19,8 @@ SAME, DIFFERENT, PARTLY, NOT_YET = "same", "different", "partly", "not yet"
 # (CGA name, status, what bgr writes where the registry cannot say it, a note)
 CGA: list[tuple[str, str, str, str]] = [
     # ---- operations ------------------------------------------------------------------------
-    ("alignScopeToAxes", NOT_YET, "", ""),
-    ("alignScopeToGeometry", NOT_YET, "", ""),
+    ("alignScopeToAxes", SAME, "", ""),
+    ("alignScopeToGeometry", PARTLY, "", "2D shapes (lots, faces); a solid's faces not yet"),
     ("center", SAME, "", ""),
     ("cleanupGeometry", NOT_YET, "", ""),
     ("color", SAME, "", ""),
@@ -51,7 +51,7 @@ CGA: list[tuple[str, str, str, str]] = [
     ("roofPyramid", DIFFERENT, "roof(pyramid, pitch, overhang)", ""),
     ("roofShed", DIFFERENT, "roof(shed, pitch, overhang)", ""),
     ("rotate", NOT_YET, "", "the scope's own turn is `r`"),
-    ("rotateScope", NOT_YET, "", ""),
+    ("rotateScope", SAME, "", ""),
     ("rotateUV", SAME, "", ""),
     ("s", SAME, "", ""),
     ("scaleUV", SAME, "", ""),

@@ -40,6 +40,7 @@ from .registry import (
     NORMALIZE_TYPE,
     NORMALIZE_TYPES,
     NUMBER,
+    NUMBER_OR_WORD,
     OFFSET_SELECTORS,
     OPERATIONS,
     PRIMITIVES,
@@ -50,6 +51,8 @@ from .registry import (
     SIZE,
     STRING,
     TEX_SIZE,
+    UP_AXES,
+    UP_AXIS,
     Op,
 )
 from .site import problems as site_problems
@@ -66,6 +69,7 @@ _SYMBOL_KINDS = {
     PROJECTION_AXES: PROJECTION_AXES_NAMES,
     NORMALIZE_MODE: NORMALIZE_MODES,
     NORMALIZE_TYPE: NORMALIZE_TYPES,
+    UP_AXIS: UP_AXES,
 }
 _TEXTURE_OPS = ("texture", "normalMap")
 _RESERVED_ALIASES = {"scope", "split", "comp", "stdlib", "geometry"}
@@ -495,6 +499,10 @@ class Checker:
             )
 
     def op_arg(self, arg, kind: str, pname: str, op: Op, local: set[str]) -> None:
+        if kind in NUMBER_OR_WORD:
+            if isinstance(arg, n.Name) and arg.name in NUMBER_OR_WORD[kind]:
+                return
+            kind = NUMBER
         if kind == ATTR_NAME:
             self.set_target(arg, op)
             return

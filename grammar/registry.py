@@ -29,6 +29,10 @@ TEX_SIZE = "texture size"  # numeric expression, 'f (a fraction of the scope) or
 PROJECTION_AXES = "projection axes"  # scope.xy, world.xz ... (setupProjection)
 NORMALIZE_MODE = "normalize mode"  # uv | uvUniform | u | v
 NORMALIZE_TYPE = "normalize type"  # separatePerFace | collectiveAllFaces
+UP_AXIS = "up axis"  # yUp | zUp (alignScopeToGeometry)
+# a number, or one of a few bare words (alignScopeToGeometry's face and edge)
+FACE_PICK = "face index or selector"  # a number | largest | world.lowest | any
+EDGE_PICK = "edge index or selector"  # a number | longest | world.lowest
 
 AXIS_NAMES = ("x", "y", "z")
 COMP_KINDS = ("f",)
@@ -55,6 +59,12 @@ PROJECTION_AXES_NAMES = tuple(
 )
 NORMALIZE_MODES = ("uv", "uvUniform", "u", "v")
 NORMALIZE_TYPES = ("separatePerFace", "collectiveAllFaces")
+UP_AXES = ("yUp", "zUp")
+# kinds that take a number or one of these words
+NUMBER_OR_WORD = {
+    FACE_PICK: ("largest", "world.lowest", "any"),
+    EDGE_PICK: ("longest", "world.lowest"),
+}
 UV_SETS = 10  # uv-sets 0..9, as CGA's texture layers (material.colormap is 0, normalmap 5)
 
 REQUIRED = object()
@@ -148,6 +158,35 @@ OPERATIONS: dict[str, Op] = {
             "name): a face's scope turns 180 degrees about its own y axis, so x and z reverse "
             "and the outline stays where it is (a lot's turns about its z).",
             "reverseNormals()",
+        ),
+        Op(
+            "rotateScope",
+            "transforms",
+            _sig(Param("x", NUMBER), Param("y", NUMBER), Param("z", NUMBER)),
+            "Turn the scope about its own axes by the given degrees (x, then y, then z) while the "
+            "geometry stays where it is, as CGA's rotateScope: the new scope is the geometry's "
+            "bounding box along the turned axes.",
+            "rotateScope(0, 90, 0)",
+        ),
+        Op(
+            "alignScopeToAxes",
+            "transforms",
+            ((), (Param("axis", AXIS),)),
+            "Turn the scope to the world's axes, the geometry staying where it is, as CGA's "
+            "alignScopeToAxes: all three, or only the one given (`y`: the scope's y becomes the "
+            "world's up and its x is laid level); the new scope is the geometry's bounding box.",
+            "alignScopeToAxes(y)",
+        ),
+        Op(
+            "alignScopeToGeometry",
+            "transforms",
+            _sig(Param("upAxis", UP_AXIS), Param("face", FACE_PICK), Param("edge", EDGE_PICK)),
+            "Turn the scope of a 2D shape to one of its edges, as CGA's alignScopeToGeometry: x "
+            "along the edge (an index of the face's outline, `longest` or `world.lowest`), the "
+            "face's normal as y (`yUp`) or z (`zUp`); the face is an index, `largest`, "
+            "`world.lowest` or `any` (the face holding the edge chosen). The geometry stays "
+            "where it is.",
+            "alignScopeToGeometry(yUp, 0, longest)",
         ),
         Op(
             "matrix",

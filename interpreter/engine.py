@@ -27,11 +27,13 @@ from bgr.grammar.registry import (
     NORMALIZE_MODE,
     NORMALIZE_TYPE,
     NUMBER,
+    NUMBER_OR_WORD,
     OPERATIONS,
     PROJECTION_AXES,
     ROOF_KIND,
     SIZE,
     TEX_SIZE,
+    UP_AXIS,
 )
 
 from .barren import handed
@@ -67,8 +69,14 @@ SYMBOL_KINDS = {
     PROJECTION_AXES,
     NORMALIZE_MODE,
     NORMALIZE_TYPE,
+    UP_AXIS,
 }
-_NUMERIC_KINDS = {NUMBER, SIZE, TEX_SIZE}  # parameters whose value must be a number
+_NUMERIC_KINDS = {
+    NUMBER,
+    SIZE,
+    TEX_SIZE,
+    *NUMBER_OR_WORD,
+}  # parameters whose value must be a number
 # operations that move or stretch a shape's geometry with its scope: its texture projections and
 # coordinates follow (texturing.follow).  reverseNormals keeps the outline where it is.
 _MOVERS = frozenset({"t", "r", "s", "center", "matrix"})
@@ -643,7 +651,11 @@ class Application:
                 plan.append((0, param.default, None, numeric))
                 continue
             arg = step.args[i]
-            if param.kind in SYMBOL_KINDS:
+            if param.kind in SYMBOL_KINDS or (
+                param.kind in NUMBER_OR_WORD
+                and isinstance(arg, n.Name)
+                and arg.name in NUMBER_OR_WORD[param.kind]
+            ):
                 plan.append((0, arg.name, None, False))
             elif isinstance(arg, n.Relative):
                 tag = "float" if arg.floating else "rel"

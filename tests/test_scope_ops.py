@@ -1,0 +1,118 @@
+"""rotateScope, alignScopeToAxes and alignScopeToGeometry: the scope turns, the geometry stays.
+
+The cases follow the examples of CityEngine's reference pages for the three operations.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import bgr
+
+
+def _derive(text: str, lot=(10.0, 20.0)):
+    return bgr.derive(bgr.load("version 1\n" + text), lot=lot)
+
+
+def _same_place(a, b) -> None:
+    """Two results with the same geometry in the world: bounds, area and volume."""
+    ma, mb = a.mesh, b.mesh
+    assert np.allclose(ma.bounds, mb.bounds, atol=1e-9)
+    assert ma.area == pytest.approx(mb.area)
+    if ma.is_watertight:  # a solid: the same volume too
+        assert abs(ma.volume) == pytest.approx(abs(mb.volume))
+
+
+def _axes(result, k: int = 0) -> np.ndarray:
+    return np.asarray(result.terminals.axes[k], dtype=float).reshape(3, 3)
+
+
+def test_align_scope_to_axes_removes_the_scopes_rotation():
+    # the reference's example: a turned scope back on the world's axes, the geometry in place
+    turned = _derive("terminal Box\nLot --> extrude(3) r(0, 30, 0) Box")
+    aligned = _derive("terminal Box\nLot --> extrude(3) r(0, 30, 0) alignScopeToAxes() Box")
+    _same_place(turned, aligned)
+    assert np.allclose(_axes(aligned), np.eye(3), atol=1e-9)
+    size = aligned.terminals.size[0]
+    bounds = aligned.mesh.bounds
+    assert np.allclose(size, bounds[1] - bounds[0], atol=1e-9)  # the bounding box
+
+
+def test_align_scope_to_axes_y_lays_x_level_and_keeps_a_lot_flat():
+    # a face of the front wall turned to world y: x stays level, the face is still a face
+    plain = _derive("terminal F\nLot --> extrude(6) comp(f) { front: r(0, 0, 30) F }")
+    result = _derive(
+        "terminal F\nLot --> extrude(6) comp(f) { front: r(0, 0, 30) alignScopeToAxes(y) F }"
+    )
+    _same_place(plain, result)
+    axes = _axes(result)
+    assert np.allclose(axes[1], [0, 1, 0], atol=1e-9)
+    assert abs(axes[0][1]) < 1e-9
+    # a lot turned about y and aligned back can still be split and extruded
+    lot = _derive(
+        "terminal P\nLot --> r(0, 40, 0) alignScopeToAxes(y) split(x) { ~1: extrude(2) P }*"
+    )
+    assert len(lot) > 1 and lot.mesh.volume == pytest.approx(10 * 20 * 2)
+
+
+def test_align_scope_to_geometry_puts_x_on_the_longest_edge():
+    # Building_From_Footprint's first step: a 10 x 20 lot aligned to its longest edge
+    result = _derive("terminal A\nLot --> alignScopeToGeometry(yUp, 0, longest) A")
+    assert result.terminals.size[0] == pytest.approx([20.0, 0.0, 10.0])
+    axes = _axes(result)
+    assert np.allclose(axes[1], [0, 1, 0]) and np.allclose(np.abs(axes[0]), [0, 0, 1])
+    # and the aligned lot is still a 2D shape: it splits and extrudes
+    mass = _derive("Lot --> alignScopeToGeometry(yUp, 0, longest) split(x) { ~4: extrude(3) }*")
+    assert len(mass) == 5 and mass.mesh.volume == pytest.approx(10 * 20 * 3)
+
+
+def test_align_scope_to_geometry_on_roof_faces_points_y_up_the_slope():
+    # the reference's example: after comp(f), zUp with the lowest edge turns a roof face's
+    # y up its slope (useful to lay tiles); the face itself does not move
+    text = "terminal F\nLot --> roof(gable, 30) comp(f) { aslant: ALIGN F }"
+    plain = _derive(text.replace("ALIGN", ""))
+    result = _derive(text.replace("ALIGN", "alignScopeToGeometry(zUp, any, world.lowest)"))
+    _same_place(plain, result)
+    for k in range(len(result)):
+        x, y, z = _axes(result, k)
+        assert abs(x[1]) < 1e-9  # the lowest edge, the eave, is level
+        assert y[1] > 0.4  # up the slope
+        assert z[1] > 0.4  # the face's normal, up and out
+
+
+def test_align_scope_to_geometry_yup_makes_the_normal_y():
+    result = _derive(
+        "terminal F\nLot --> extrude(4) comp(f) { front: alignScopeToGeometry(yUp, 0, 0) F }"
+    )
+    x, y, _ = _axes(result)
+    assert np.allclose(y, [0, 0, -1], atol=1e-9)  # the front face looks to -z
+    assert result.terminals.size[0][1] == pytest.approx(0.0)
+    with pytest.raises(bgr.BgrError, match="alignScopeToGeometry\\(\\) of a solid"):
+        _derive("Lot --> extrude(4) alignScopeToGeometry(yUp, 0, 0)")
+
+
+def test_rotate_scope_turns_the_scope_not_the_geometry():
+    plain = _derive("terminal Box\nLot --> extrude(3) Box")
+    turned = _derive("terminal Box\nLot --> extrude(3) rotateScope(0, 90, 0) Box")
+    _same_place(plain, turned)
+    assert turned.terminals.size[0] == pytest.approx([20.0, 3.0, 10.0])
+    # about the extrusion axis it stays a prism: it can still be split
+    split = _derive("Lot --> extrude(3) rotateScope(0, 90, 0) split(x) { ~5: A }*\nA --> NIL")
+    assert len(split) == 0
+    # r() turns both: the geometry moves
+    moved = _derive("terminal Box\nLot --> extrude(3) r(0, 90, 0) Box")
+    assert not np.allclose(moved.mesh.bounds, plain.mesh.bounds)
+    # any angle: the scope is the geometry's bounding box along the turned axes
+    skew = _derive("terminal Box\nLot --> extrude(3) rotateScope(0, 45, 0) Box")
+    _same_place(plain, skew)
+    assert skew.terminals.size[0][0] == pytest.approx((10 + 20) / np.sqrt(2))
+
+
+def test_rotate_scope_then_insert_fits_the_turned_scope():
+    # Candler's Ventilator: a scope turned before i() sets which way the asset lies; +90 about
+    # y takes x to -z (right-handed, as r())
+    result = _derive("terminal C\nLot --> s(4, 0, 1) rotateScope(0, 90, 0) i(cylinder) C")
+    assert np.allclose(_axes(result)[0], [0, 0, -1], atol=1e-9)
+    assert result.terminals.size[0] == pytest.approx([1.0, 2.5, 4.0])  # y: the mean of x and z
+    assert np.allclose(result.mesh.bounds, [[0, 0, 0], [4, 2.5, 1]], atol=1e-9)
