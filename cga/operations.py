@@ -20,6 +20,7 @@ from ..grammar.registry import (
     NUMBER_OR_WORD,
     OPERATIONS,
     PROJECTION_AXES_NAMES,
+    SHAPE_ATTRIBUTES,
     SIZE,
     TEX_SIZE,
     UP_AXES,
@@ -342,6 +343,8 @@ def set_value(tr: Translator, args: list, meta) -> list:
         return texture(tr, TEXTURE_MAPS[target], args[1:], meta)
     if target == "material.color.rgb" or target == "material.color":
         return [n.Operation("color", [tr.expr(args[1])], pos=pos(meta))]
+    if target in SHAPE_ATTRIBUTES:
+        return [n.Operation("set", [n.Name(target), tr.expr(args[1])], pos=pos(meta))]
     attr = tr.attr_name(target) if target else None
     if attr is None:
         tr.warn(

@@ -78,7 +78,13 @@ CGA: list[tuple[str, str, str, str]] = [
     ("tileUV", SAME, "", ""),
     ("translate", NOT_YET, "", "the scope's own move is `t`"),
     ("translateUV", SAME, "", ""),
-    ("trim", NOT_YET, "", ""),
+    (
+        "trim",
+        PARTLY,
+        "set(trim.vertical, false)",
+        "vertical trim planes from comp(f) cut what i() inserts; `set(trim.vertical, false)`; "
+        "the trim() operation and horizontal planes not yet",
+    ),
     # ---- functions -------------------------------------------------------------------------
     ("abs", SAME, "", ""),
     ("acos", SAME, "", ""),

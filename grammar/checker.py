@@ -48,6 +48,7 @@ from .registry import (
     PROJECTION_AXES_NAMES,
     ROOF_KIND,
     ROOF_KINDS,
+    SHAPE_ATTRIBUTES,
     SIZE,
     STRING,
     TEX_SIZE,
@@ -484,6 +485,8 @@ class Checker:
         """set()'s first argument: a bare word naming an attr of this file."""
         if not isinstance(arg, n.Name):
             self.error(arg.pos, "set() changes an attr: name it bare", f"for example: {op.example}")
+        elif arg.name in SHAPE_ATTRIBUTES:
+            return
         elif arg.name in self.g.consts:
             self.error(arg.pos, f"'{arg.name}' is a const: set() changes attrs only")
         elif arg.name in self.g.attrs:

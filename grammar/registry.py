@@ -60,6 +60,9 @@ PROJECTION_AXES_NAMES = tuple(
 NORMALIZE_MODES = ("uv", "uvUniform", "u", "v")
 NORMALIZE_TYPES = ("separatePerFace", "collectiveAllFaces")
 UP_AXES = ("yUp", "zUp")
+# CGA's shape attributes set() may change besides a file's attrs: whether trim planes cut
+# (bgr makes vertical ones only, so trim.horizontal changes nothing)
+SHAPE_ATTRIBUTES = ("trim.vertical", "trim.horizontal")
 # kinds that take a number or one of these words
 NUMBER_OR_WORD = {
     FACE_PICK: ("largest", "world.lowest", "any"),
@@ -320,7 +323,8 @@ OPERATIONS: dict[str, Op] = {
             _sig(Param("attribute", ATTR_NAME), Param("value", VALUE)),
             "Set an attr of this file for the shape and every shape derived from it, as CGA's "
             "set(): rules below read the new value, the rest of the lot the old one (attrs "
-            "computed from it keep theirs).",
+            "computed from it keep theirs). `set(trim.vertical, false)` stops the trim planes "
+            "cutting what the shape's subtree inserts.",
             "set(floors, floors - 1)",
         ),
         # -- reports -------------------------------------------------------------------------

@@ -52,6 +52,7 @@ from .limits import (
 )
 from .operations import IMPLEMENTATIONS
 from .operations.texturing import follow
+from .operations.trims import DELETED, moved_trims
 from .randomness import Stream, child_hash, name_hash, root_hash
 from .reuse import Reuse
 from .shapes import Flat, Shape, Solid
@@ -277,6 +278,8 @@ class Engine:
                     # derived at the world's origin and moved when done (reuse.py), so that
                     # a replay and a derivation make the same numbers
                     where = (tuple(shape.origin), shape.path)
+                    if shape.trims:  # the trim planes move with it
+                        shape.trims = moved_trims(shape.trims, shape.origin)
                     shape.origin = [0.0, 0.0, 0.0]
                     stack.append((RECORDED, key, where, len(table.label), marks))
                 app = Application(self, shape, module, rule_node, args, indices)
@@ -565,7 +568,11 @@ class Application:
                     if shape.tex is not None and step.name in _MOVERS
                     else None
                 )
-                if IMPLEMENTATIONS[step.name](self, shape, step, self.arguments(step, received)):
+                done = IMPLEMENTATIONS[step.name](self, shape, step, self.arguments(step, received))
+                if done:
+                    if done is DELETED:  # nothing is left of it (an insert trimmed away)
+                        self.ctx.shape = shape
+                        return True
                     consumed = True
                 if moved is not None:
                     follow(shape, *moved)

@@ -27,6 +27,7 @@ from bgr.grammar.registry import OPERATIONS
 from .expressions import RuleRef
 from .geometry.polygons import RECT
 from .limits import MEMORY_CHECK_EVERY
+from .operations.trims import relative
 from .shapes import Flat, Prism, Solid
 
 # names whose value depends on where the shape is, or on its place among its siblings
@@ -141,6 +142,67 @@ def _block_ok(module, entries, local: set, known: dict) -> bool:
         ):
             return False
     return True
+
+
+def inserts(module, name: str, known: dict) -> bool:
+    """Whether rule ``name`` can reach an ``i()`` (its subtree is what trim planes cut: their
+    place is then part of its reuse key); a rule held in a parameter counts as one that can.
+    ``known`` caches the answers; too deep a chain is answered yes."""
+    key = ("i", id(module), name)
+    if key in known:
+        return known[key]
+    try:
+        return _inserts(module, name, known)
+    except RecursionError:
+        return True
+
+
+def _inserts(module, name: str, known: dict) -> bool:
+    key = ("i", id(module), name)
+    if key in known:
+        return known[key]
+    known[key] = False  # a rule that reaches itself: decided by the rest of its body
+    rule = module.rules.get(name)
+    if rule is None:
+        return False
+    body = rule.body
+    sequences = (
+        [body.steps]
+        if isinstance(body, n.Sequence)
+        else [c.body.steps for c in getattr(body, "cases", getattr(body, "choices", []))]
+    )
+    found = any(_steps_insert(module, steps, set(rule.params), known) for steps in sequences)
+    known[key] = found
+    return found
+
+
+def _steps_insert(module, steps, local: set, known: dict) -> bool:
+    for step in steps:
+        if isinstance(step, n.Push):
+            if _steps_insert(module, step.steps, local, known):
+                return True
+        elif isinstance(step, n.Successor):
+            if step.name in local:
+                return True
+            target, member = module.lookup_module(step.name)
+            if _inserts(target, member, known):
+                return True
+        elif isinstance(step, n.Operation):
+            if step.name == "i":
+                return True
+            if step.block is not None and _entries_insert(module, step.block.entries, local, known):
+                return True
+    return False
+
+
+def _entries_insert(module, entries, local: set, known: dict) -> bool:
+    for entry in entries:
+        if isinstance(entry, n.Group):
+            if _entries_insert(module, entry.entries, local, known):
+                return True
+        elif _steps_insert(module, entry.body.steps, local, known):
+            return True
+    return False
 
 
 def _spawns(rule: n.Rule) -> bool:
@@ -304,6 +366,8 @@ class Reuse:
             shape.label,
             shape.depth,
             shape.attrs,  # values set() gave attrs for this shape and what it derives
+            # trim planes cut what the subtree inserts: where they stand matters only then
+            relative(shape) if shape.trims and inserts(module, rule.name, self.known) else (),
         )
         try:
             found = self.records.get(key)

@@ -60,6 +60,7 @@ class Shape:
         "frame",
         "tex",
         "attrs",
+        "trims",
     )
 
     def __init__(
@@ -90,6 +91,9 @@ class Shape:
         # attrs set() on this shape or an ancestor: ((id(module), name), value) pairs sorted by
         # key, a tuple so that it can be part of a reuse key; None: none (operations/attributes)
         self.attrs: tuple | None = None
+        # CGA's trim planes: ((point, normal), ...) in world coordinates, the kept side where
+        # the normal points; a comp(f) face gets one at each vertical edge (operations/trims.py)
+        self.trims: tuple = ()
 
     def copy(self) -> Shape:
         # slot by slot, not through __init__: a derivation copies shapes millions of times
@@ -107,6 +111,7 @@ class Shape:
         twin.frame = self.frame
         twin.tex = self.tex  # immutable: shared until an operation replaces it
         twin.attrs = self.attrs  # immutable too
+        twin.trims = self.trims  # immutable too
         return twin
 
     def cut_from(self, parent: Shape) -> Shape:

@@ -10,6 +10,8 @@ computed from the changed one keep the values they had when the lot began, as in
 
 from __future__ import annotations
 
+from bgr.grammar.registry import SHAPE_ATTRIBUTES
+
 from ..expressions import RuleRef, runtime_error
 
 
@@ -22,6 +24,12 @@ def set_attr(app, shape, step, args) -> bool:
             f"set({name}, ...) takes a number, a string or true/false, not the rule "
             f"'{value.member}'",
         )
+    if name in SHAPE_ATTRIBUTES:
+        if not isinstance(value, bool):
+            raise runtime_error(app.module, step.pos, f"set({name}, ...) takes true or false")
+        if name == "trim.vertical" and not value:
+            shape.trims = ()  # until a comp(f) makes new ones
+        return False
     key = (id(app.module), name)
     values = dict(shape.attrs or ())
     values[key] = value

@@ -25,6 +25,7 @@ from ..geometry.polygons import (
 )
 from ..shapes import Flat, Prism, Solid, cross, dot, normalise
 from ..terminals import UnitMesh
+from .trims import corner_planes
 
 # ---- comp(f) -----------------------------------------------------------------------------------
 
@@ -222,6 +223,9 @@ def _matches(app, key, kind: str, index: int, slant: str) -> bool:
     return name == "side" and kind not in ("top", "bottom")
 
 
+_BOXES = ("cube", "extrusion")  # solids whose walls get trim planes, as a prism's do
+
+
 def comp(app, shape, step, args) -> bool:
     faces = _faces(app, step, shape)
     left = app.engine.max_shapes - app.engine.shapes
@@ -236,6 +240,8 @@ def comp(app, shape, step, args) -> bool:
     kinds = [_classify(nrm) for _, nrm, _ in faces]
     slants = [_slant(nrm) for _, nrm, _ in faces]
     taken = [False] * len(faces)
+    geom = shape.geom
+    walls = isinstance(geom, Prism) or (isinstance(geom, Solid) and geom.name in _BOXES)
     for entry in step.block.entries:
         selector = entry.key.name if isinstance(entry.key, n.Name) else "face"
         chosen = [
@@ -250,6 +256,8 @@ def comp(app, shape, step, args) -> bool:
             face = _face_shape(shape, rings, nrm)
             app.engine.count_shape(app.module, entry.pos)
             corners = _left_right(rings, nrm, turns)
+            # a wall of a solid: trim planes at its corners (a new comp's replace the old)
+            face.trims = corner_planes(face, *corners) if walls and abs(nrm[1]) <= 0.7071 else ()
             app.piece(face, entry.body, comp=(j, len(chosen), *corners, selector))
     return True
 

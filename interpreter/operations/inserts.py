@@ -13,6 +13,7 @@ from bgr.grammar.registry import PRIMITIVES
 from ..expressions import runtime_error
 from ..shapes import Solid
 from ..terminals import UnitMesh
+from .trims import DELETED, trim_insert
 
 
 def insert(app, shape, step, args) -> bool:
@@ -23,7 +24,7 @@ def insert(app, shape, step, args) -> bool:
         extent = (1.0, 1.0, 0.0) if name == "quad" else (1.0, 1.0, 1.0)
         shape.size = fitted_size(shape.size, extent)
         shape.geom = Solid(app.engine.primitive_id(name), name)
-        return False
+        return False if trim_insert(app, shape) else DELETED
     module, member = app.module.lookup_module(name)
     asset = module.assets[member]
     mesh_id, extent, offset = _load_asset(app, step, module, asset)
@@ -31,7 +32,7 @@ def insert(app, shape, step, args) -> bool:
         shape.origin = shape.world(offset)
     shape.size = fitted_size(shape.size, extent)
     shape.geom = Solid(mesh_id, member)
-    return False
+    return False if trim_insert(app, shape) else DELETED
 
 
 def fitted_size(size, extent) -> list[float]:

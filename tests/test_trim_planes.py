@@ -1,0 +1,78 @@
+"""CGA's trim planes: an inserted mesh is cut where its façade meets the next one.
+
+As in CityEngine's trim-plane examples: a ledge inserted longer than its façade (Candler's
+s('1.4, ...) center(x) i(ledge)) meets the next façade's ledge in a mitre at the corner instead
+of running on past it.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import bgr
+
+LEDGES = """version 1
+terminal Ledge
+Lot --> extrude(3) comp(f) { side: s('1.4, 0.5, 0.5) center(x) i(cube) Ledge }
+"""
+
+
+def test_ledges_meet_in_a_mitre_at_the_corners():
+    result = bgr.derive(bgr.load(LEDGES), lot=(10.0, 10.0))
+    bounds = result.mesh.bounds
+    # without trim planes each ledge would run 2 m past both corners
+    assert np.allclose(bounds[0][[0, 2]], [-0.5, -0.5], atol=1e-9)
+    assert np.allclose(bounds[1][[0, 2]], [10.5, 10.5], atol=1e-9)
+    # each ledge is cut at 45 degrees: its outer edge is 11 m long, its inner one 10 m
+    for k in range(len(result)):
+        size = result.terminals.size[k]
+        assert size[0] == pytest.approx(14.0)  # the scope keeps its size; the mesh is cut
+
+
+def test_a_mesh_wholly_past_the_corner_is_gone_and_inside_ones_are_untouched():
+    text = """version 1
+terminal Out, In
+Lot --> extrude(3) comp(f) { front: [ t(-3, 0, 0) s(1, 1, 1) i(cube) Out ] s(1, 1, 1) i(cube) In }
+"""
+    result = bgr.derive(bgr.load(text), lot=(10.0, 10.0))
+    assert list(result.terminals.label) == ["In"]
+    assert len(result.mesh.faces) == 12  # the box inside the façade is whole
+
+
+def test_trims_follow_the_subtree_and_the_reuse_keeps_them_apart():
+    # every floor of a façade carries its corner planes down to the inserts of its tiles;
+    # identical floors are derived once and replayed, tiles at the corners are cut
+    text = """version 1
+terminal Bar
+Lot --> extrude(9) comp(f) { side: Facade }
+Facade --> split(y) { ~3: Floor }*
+Floor --> split(x) { ~2.5: Tile }*
+Tile --> s('1.6, 0.2, 0.3) center(x) i(cube) Bar
+"""
+    grammar = bgr.load(text)
+    result = bgr.derive(grammar, lot=(10.0, 10.0))
+    bounds = result.mesh.bounds
+    assert np.allclose(bounds[0][[0, 2]], [-0.3, -0.3], atol=1e-9)
+    assert np.allclose(bounds[1][[0, 2]], [10.3, 10.3], atol=1e-9)
+    # cut bars (at the corners) have more triangles than whole ones (12)
+    per_row = [len(result.terminals.library.meshes[m].faces) for m in result.terminals.mesh]
+    assert sorted(set(per_row))[0] == 12 and max(per_row) > 12
+
+
+def test_without_reuse_the_same_bytes(tmp_path, monkeypatch):
+    text = LEDGES.replace("i(cube) Ledge", "i(cube) Ledge") + "\n"
+    a = tmp_path / "a.glb"
+    b = tmp_path / "b.glb"
+    bgr.derive(bgr.load(text), lot=(10.0, 10.0)).save(a)
+    monkeypatch.setenv("BGR_REUSE", "0")
+    bgr.derive(bgr.load(text), lot=(10.0, 10.0)).save(b)
+    assert a.read_bytes() == b.read_bytes()
+
+
+def test_set_trim_vertical_false_keeps_the_mesh_whole():
+    # complexpatterns' railing: set(trim.vertical, false) so that the corner bars are not cut
+    text = LEDGES.replace("side: s(", "side: set(trim.vertical, false) s(")
+    result = bgr.derive(bgr.load(text), lot=(10.0, 10.0))
+    assert np.allclose(result.mesh.bounds[0][[0, 2]], [-2.0, -2.0], atol=1e-9)
+    assert len(result.mesh.faces) == 4 * 12
