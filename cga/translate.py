@@ -31,7 +31,7 @@ from ..grammar.errors import Diagnostic, source_line
 from ..grammar.registry import BUILTIN_NAMES, BUILTINS, KEYWORDS, OPERATIONS
 from . import operations as ops
 from .expressions import Expressions, dotted, pos, unquote
-from .start import At, shape_attrs
+from .start import At, prepend_to_start, shape_attrs
 
 GEOMETRY_FILES = (".obj", ".glb", ".gltf", ".fbx", ".dae", ".ply", ".stl", ".3ds")
 EMPTY = "t"  # a step that changes nothing: a sequence CGA leaves empty keeps its shape as a leaf
@@ -250,6 +250,9 @@ class Translator:
             notes = []
         self.drop_notes(notes, "the end of the file")
         items = shape_attrs(self, items, attrs, consts)
+        if self.inserts():  # CGA's trim planes are on from the start; bgr's wait for this
+            trim_on = n.Operation("set", [n.Name("trim.vertical"), n.Bool(True)])
+            items = prepend_to_start(self, items, [trim_on])
         # the declarations bgr wants up front stand on the version's line, so that comments
         # keep their places around them
         head = items[0].pos if items[0].pos.line else n.Pos(1, 1, 1, 1)
@@ -578,6 +581,14 @@ class Translator:
             return None
         value = self.expr(t)
         return n.Binary("+", n.String(prefix), value) if prefix else value
+
+    def inserts(self) -> bool:
+        """Whether the file inserts anything (i(), primitiveCube()...): trim planes cut that."""
+        names = {"i", *ops.PRIMITIVES}
+        return any(
+            dotted(t.children[0]) in names
+            for t in self.tree.find_pred(lambda t: t.data in ("call", "successor"))
+        )
 
     def file_strings(self, suffixes: tuple, builtin: bool = False) -> set[str]:
         out = set()

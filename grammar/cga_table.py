@@ -81,9 +81,9 @@ CGA: list[tuple[str, str, str, str]] = [
     (
         "trim",
         PARTLY,
-        "set(trim.vertical, false)",
-        "vertical trim planes from comp(f) cut what i() inserts; `set(trim.vertical, false)`; "
-        "the trim() operation and horizontal planes not yet",
+        "set(trim.vertical, true)",
+        "vertical trim planes from comp(f) cut what i() inserts, once turned on (import-cga "
+        "does); the trim() operation and horizontal planes not yet",
     ),
     # ---- functions -------------------------------------------------------------------------
     ("abs", SAME, "", ""),

@@ -323,8 +323,8 @@ OPERATIONS: dict[str, Op] = {
             _sig(Param("attribute", ATTR_NAME), Param("value", VALUE)),
             "Set an attr of this file for the shape and every shape derived from it, as CGA's "
             "set(): rules below read the new value, the rest of the lot the old one (attrs "
-            "computed from it keep theirs). `set(trim.vertical, false)` stops the trim planes "
-            "cutting what the shape's subtree inserts.",
+            "computed from it keep theirs). `set(trim.vertical, true)` turns CGA's trim planes "
+            "on for the shape's subtree (`false` off).",
             "set(floors, floors - 1)",
         ),
         # -- reports -------------------------------------------------------------------------

@@ -53,6 +53,7 @@ from .limits import (
 from .operations import IMPLEMENTATIONS
 from .operations.texturing import follow
 from .operations.trims import DELETED, moved_trims
+from .operations.trims import kept as kept_trims
 from .randomness import Stream, child_hash, name_hash, root_hash
 from .reuse import Reuse
 from .shapes import Flat, Shape, Solid
@@ -260,6 +261,8 @@ class Engine:
                     reuse.record(self, *item[1:])
                     continue
                 shape, module, rule_node, args, indices = item
+                if shape.trims:  # planes too far to matter are dropped before the key is made
+                    shape.trims = kept_trims(shape)
                 known = reuse.lookup(shape, module, rule_node, args)
                 if known is not None:
                     key, found = known

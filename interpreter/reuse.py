@@ -366,8 +366,11 @@ class Reuse:
             shape.label,
             shape.depth,
             shape.attrs,  # values set() gave attrs for this shape and what it derives
-            # trim planes cut what the subtree inserts: where they stand matters only then
-            relative(shape) if shape.trims and inserts(module, rule.name, self.known) else (),
+            # trim planes cut what the subtree inserts: whether they are on and where they
+            # stand matters only then
+            (relative(shape) if shape.trims else shape.trims is not None)
+            if inserts(module, rule.name, self.known)
+            else (),
         )
         try:
             found = self.records.get(key)

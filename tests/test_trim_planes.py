@@ -14,7 +14,8 @@ import bgr
 
 LEDGES = """version 1
 terminal Ledge
-Lot --> extrude(3) comp(f) { side: s('1.4, 0.5, 0.5) center(x) i(cube) Ledge }
+Lot --> set(trim.vertical, true) extrude(3) comp(f) { side: Ledges }
+Ledges --> s('1.4, 0.5, 0.5) center(x) i(cube) Ledge
 """
 
 
@@ -33,7 +34,9 @@ def test_ledges_meet_in_a_mitre_at_the_corners():
 def test_a_mesh_wholly_past_the_corner_is_gone_and_inside_ones_are_untouched():
     text = """version 1
 terminal Out, In
-Lot --> extrude(3) comp(f) { front: [ t(-3, 0, 0) s(1, 1, 1) i(cube) Out ] s(1, 1, 1) i(cube) In }
+Lot --> set(trim.vertical, true) extrude(3) comp(f) {
+    front: [ t(-3, 0, 0) s(1, 1, 1) i(cube) Out ] s(1, 1, 1) i(cube) In
+}
 """
     result = bgr.derive(bgr.load(text), lot=(10.0, 10.0))
     assert list(result.terminals.label) == ["In"]
@@ -45,7 +48,7 @@ def test_trims_follow_the_subtree_and_the_reuse_keeps_them_apart():
     # identical floors are derived once and replayed, tiles at the corners are cut
     text = """version 1
 terminal Bar
-Lot --> extrude(9) comp(f) { side: Facade }
+Lot --> set(trim.vertical, true) extrude(9) comp(f) { side: Facade }
 Facade --> split(y) { ~3: Floor }*
 Floor --> split(x) { ~2.5: Tile }*
 Tile --> s('1.6, 0.2, 0.3) center(x) i(cube) Bar
@@ -70,9 +73,13 @@ def test_without_reuse_the_same_bytes(tmp_path, monkeypatch):
     assert a.read_bytes() == b.read_bytes()
 
 
-def test_set_trim_vertical_false_keeps_the_mesh_whole():
-    # complexpatterns' railing: set(trim.vertical, false) so that the corner bars are not cut
-    text = LEDGES.replace("side: s(", "side: set(trim.vertical, false) s(")
-    result = bgr.derive(bgr.load(text), lot=(10.0, 10.0))
-    assert np.allclose(result.mesh.bounds[0][[0, 2]], [-2.0, -2.0], atol=1e-9)
-    assert len(result.mesh.faces) == 4 * 12
+def test_trimming_is_off_until_set_and_set_false_turns_it_off():
+    # complexpatterns' railing: set(trim.vertical, false) so that the corner bars are not cut;
+    # a grammar written for bgr has trimming off unless it turns it on
+    for text in (
+        LEDGES.replace("Ledges --> s(", "Ledges --> set(trim.vertical, false) s("),
+        LEDGES.replace("set(trim.vertical, true) ", ""),
+    ):
+        result = bgr.derive(bgr.load(text), lot=(10.0, 10.0))
+        assert np.allclose(result.mesh.bounds[0][[0, 2]], [-2.0, -2.0], atol=1e-9)
+        assert len(result.mesh.faces) == 4 * 12

@@ -27,8 +27,11 @@ def set_attr(app, shape, step, args) -> bool:
     if name in SHAPE_ATTRIBUTES:
         if not isinstance(value, bool):
             raise runtime_error(app.module, step.pos, f"set({name}, ...) takes true or false")
-        if name == "trim.vertical" and not value:
-            shape.trims = ()  # until a comp(f) makes new ones
+        if name == "trim.vertical":
+            if not value:
+                shape.trims = None  # off for the shape and what it derives
+            elif shape.trims is None:
+                shape.trims = ()  # on: the next comp(f) of a solid makes planes
         return False
     key = (id(app.module), name)
     values = dict(shape.attrs or ())

@@ -256,8 +256,11 @@ def comp(app, shape, step, args) -> bool:
             face = _face_shape(shape, rings, nrm)
             app.engine.count_shape(app.module, entry.pos)
             corners = _left_right(rings, nrm, turns)
-            # a wall of a solid: trim planes at its corners (a new comp's replace the old)
-            face.trims = corner_planes(face, *corners) if walls and abs(nrm[1]) <= 0.7071 else ()
+            # with trimming on, a wall of a solid gets trim planes at its corners (a new comp's
+            # replace the old)
+            if face.trims is not None:
+                wall = walls and abs(nrm[1]) <= 0.7071
+                face.trims = corner_planes(face, *corners) if wall else ()
             app.piece(face, entry.body, comp=(j, len(chosen), *corners, selector))
     return True
 

@@ -4,8 +4,18 @@
 halves the corner with the neighbouring wall (CGA's trim planes).  Every shape derived from the
 face keeps them, and ``i()`` cuts the inserted mesh by them, so that a ledge or a cornice made
 longer than its façade meets its neighbour's in a mitre at the corner instead of running past
-it.  Splits do not cut (their pieces never leave the face).  The planes are in world
-coordinates; the reuse of repeated subtrees keys on them relative to the shape's origin.
+it.  Splits do not cut (their pieces never leave the face).
+
+Trimming is off in a bgr grammar until ``set(trim.vertical, true)`` (``Shape.trims`` is None);
+CGA has it on from the start, so ``bgr import-cga`` writes that first in the start rule.  Off by
+default, grammars written for bgr keep their outputs, and their repeated subtrees replay as
+before.
+
+A plane is (normal, c): the kept side is where normal . point >= c, in world coordinates.  A
+shape farther from a plane than its own largest size (a tile in the middle of a façade) drops
+it (:func:`kept`): what it inserts would have to be more than twice its size to reach the plane,
+and the reuse of repeated subtrees, which keys on the planes a shape keeps (relative to its
+origin), then replays such tiles as before.
 """
 
 from __future__ import annotations
@@ -27,38 +37,50 @@ def corner_planes(face: Shape, left: float, right: float) -> tuple:
     degrees (comp.left, comp.right: 90 at a box's corners): through its left and right edges,
     halving each corner, kept on the face's side."""
     half_l, half_r = math.radians(left) / 2, math.radians(right) / 2
-    at_left = tuple(face.origin)
-    at_right = tuple(face.world((face.size[0], 0.0, 0.0)))
+    at_left = face.origin
+    at_right = face.world((face.size[0], 0.0, 0.0))
     n_left = tuple(face.direction((math.cos(half_l), 0.0, math.sin(half_l))))
     n_right = tuple(face.direction((-math.cos(half_r), 0.0, math.sin(half_r))))
-    return ((at_left, n_left), (at_right, n_right))
+    return ((n_left, _dot(n_left, at_left)), (n_right, _dot(n_right, at_right)))
+
+
+def _dot(a, b) -> float:
+    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+
+
+def kept(shape: Shape) -> tuple:
+    """The shape's trim planes without those it lies farther from than its own largest size."""
+    reach = max(shape.size)
+    return tuple((n, c) for n, c in shape.trims if _least(shape, n, c) <= reach)
+
+
+def _least(shape: Shape, normal, c: float) -> float:
+    """The least signed distance of the shape's scope box from a plane (negative: it crosses
+    or lies behind it)."""
+    least = _dot(normal, shape.origin) - c
+    for axis, size in zip(shape.axes, shape.size, strict=True):
+        least += min(0.0, size * _dot(normal, axis))
+    return least
 
 
 def moved_trims(trims: tuple, origin) -> tuple:
     """Trim planes as seen from ``origin``: a subtree derived at the world's origin (reuse)."""
-    return tuple(((p[0] - origin[0], p[1] - origin[1], p[2] - origin[2]), n) for p, n in trims)
+    return tuple((normal, c - _dot(normal, origin)) for normal, c in trims)
 
 
 def relative(shape: Shape) -> tuple:
     """The shape's trim planes relative to its origin, rounded: part of a reuse key."""
     o = shape.origin
     return tuple(
-        (
-            round(p[0] - o[0], 9),
-            round(p[1] - o[1], 9),
-            round(p[2] - o[2], 9),
-            round(n[0], 9),
-            round(n[1], 9),
-            round(n[2], 9),
-        )
-        for p, n in shape.trims
+        (round(n[0], 9), round(n[1], 9), round(n[2], 9), round(c - _dot(n, o), 9))
+        for n, c in shape.trims
     )
 
 
 def trim_insert(app, shape: Shape) -> bool:
     """Cut the shape's inserted mesh by its trim planes; False when nothing of it is left."""
-    if not shape.trims:
-        return True
+    if not shape.trims or all(_least(shape, n, c) >= 0 for n, c in shape.trims):
+        return True  # the scope's box (which holds the fitted mesh) is wholly on the kept side
     library = app.engine.table.library
     mesh = library.meshes[shape.geom.mesh]
     axes = np.asarray(shape.axes, dtype=np.float64)
@@ -66,9 +88,10 @@ def trim_insert(app, shape: Shape) -> bool:
     origin = np.asarray(shape.origin, dtype=np.float64)
     verts, faces, uv = mesh.vertices, mesh.faces, mesh.uv
     changed = False
-    for point, normal in shape.trims:
+    for normal, c in shape.trims:
         # the plane in the mesh's unit coordinates: u = ((w - o) . a_i) / s_i
-        p = np.divide((np.asarray(point) - origin) @ axes.T, size, out=np.zeros(3), where=size > 0)
+        point = np.asarray(normal) * c  # the plane's point nearest the world's origin
+        p = np.divide((point - origin) @ axes.T, size, out=np.zeros(3), where=size > 0)
         n = (axes @ np.asarray(normal)) * size
         side = (verts - p) @ n
         scale = float(np.abs(n).max()) or 1.0
