@@ -17,6 +17,7 @@ from lark import Tree
 
 from ..grammar import nodes as n
 from ..grammar.registry import (
+    CLEANUP_KINDS,
     NUMBER_OR_WORD,
     OPERATIONS,
     PROJECTION_AXES_NAMES,
@@ -57,10 +58,13 @@ SAME = {
     "rotateScope",
     "alignScopeToAxes",
     "alignScopeToGeometry",
+    "mirror",
+    "cleanupGeometry",
 }
 # operations some of whose arguments are bare words
 WORDS_TAKEN = (
     "center", "setupProjection", "normalizeUV", "alignScopeToAxes", "alignScopeToGeometry",
+    "cleanupGeometry",
 )  # fmt: skip
 ROOFS = {"roofGable": "gable", "roofHip": "hip", "roofPyramid": "pyramid", "roofShed": "shed"}
 PRIMITIVES = {
@@ -73,9 +77,7 @@ BUILTIN_ASSETS = {"cube": "cube", "cylinder": "cylinder", "sphere": "sphere", "q
 # operations that change the shape in a way bgr cannot yet: dropped, the shape goes on as it was
 DROPPED = {
     "convexify",
-    "cleanupGeometry",
     "envelope",
-    "mirror",
     "mirrorScope",
     "trim",
     "setPivot",
@@ -382,6 +384,6 @@ def is_symbol_arg(t, projection: bool) -> str | None:
         return word
     if word in ("uv", "uvUniform", "u", "v", "separatePerFace", "collectiveAllFaces"):
         return word
-    if word in UP_AXES or any(word in words for words in NUMBER_OR_WORD.values()):
+    if word in UP_AXES or word in CLEANUP_KINDS or any(word in w for w in NUMBER_OR_WORD.values()):
         return word
     return None

@@ -24,6 +24,8 @@ from .registry import (
     AXIS_NAMES,
     BUILTIN_NAMES,
     BUILTINS,
+    CLEANUP_KIND,
+    CLEANUP_KINDS,
     COLOR,
     COMP_KIND,
     COMP_KINDS,
@@ -71,6 +73,7 @@ _SYMBOL_KINDS = {
     NORMALIZE_MODE: NORMALIZE_MODES,
     NORMALIZE_TYPE: NORMALIZE_TYPES,
     UP_AXIS: UP_AXES,
+    CLEANUP_KIND: CLEANUP_KINDS,
 }
 _TEXTURE_OPS = ("texture", "normalMap")
 _RESERVED_ALIASES = {"scope", "split", "comp", "stdlib", "geometry"}

@@ -30,6 +30,7 @@ PROJECTION_AXES = "projection axes"  # scope.xy, world.xz ... (setupProjection)
 NORMALIZE_MODE = "normalize mode"  # uv | uvUniform | u | v
 NORMALIZE_TYPE = "normalize type"  # separatePerFace | collectiveAllFaces
 UP_AXIS = "up axis"  # yUp | zUp (alignScopeToGeometry)
+CLEANUP_KIND = "components"  # all | faces | edges | vertices (cleanupGeometry)
 # a number, or one of a few bare words (alignScopeToGeometry's face and edge)
 FACE_PICK = "face index or selector"  # a number | largest | world.lowest | any
 EDGE_PICK = "edge index or selector"  # a number | longest | world.lowest
@@ -60,6 +61,7 @@ PROJECTION_AXES_NAMES = tuple(
 NORMALIZE_MODES = ("uv", "uvUniform", "u", "v")
 NORMALIZE_TYPES = ("separatePerFace", "collectiveAllFaces")
 UP_AXES = ("yUp", "zUp")
+CLEANUP_KINDS = ("all", "faces", "edges", "vertices")
 # CGA's shape attributes set() may change besides a file's attrs: whether trim planes cut
 # (bgr makes vertical ones only, so trim.horizontal changes nothing)
 SHAPE_ATTRIBUTES = ("trim.vertical", "trim.horizontal")
@@ -190,6 +192,23 @@ OPERATIONS: dict[str, Op] = {
             "`world.lowest` or `any` (the face holding the edge chosen). The geometry stays "
             "where it is.",
             "alignScopeToGeometry(yUp, 0, longest)",
+        ),
+        Op(
+            "mirror",
+            "transforms",
+            _sig(Param("x", VALUE), Param("y", VALUE), Param("z", VALUE)),
+            "Mirror the geometry inside its scope along each axis given true (the scope stays), "
+            "as CGA's mirror: `mirror(true, false, false)` flips it left to right.",
+            "mirror(true, false, false)",
+        ),
+        Op(
+            "cleanupGeometry",
+            "transforms",
+            _sig(Param("components", CLEANUP_KIND), Param("tolerance", NUMBER)),
+            "Merge points closer than `tolerance` metres and drop faces left without area, as "
+            "CGA's cleanupGeometry (`all`, `faces`, `edges` or `vertices`: each is read as all); "
+            "bgr's own shapes are exact, so it changes inserted meshes and outlines from files.",
+            "cleanupGeometry(all, 0.01)",
         ),
         Op(
             "matrix",

@@ -20,6 +20,7 @@ from bgr.grammar.registry import (
     ATTR_NAME,
     AXES,
     AXIS,
+    CLEANUP_KIND,
     COMP_KIND,
     EXTRUDE_KIND,
     FOOTPRINT_KIND,
@@ -72,6 +73,7 @@ SYMBOL_KINDS = {
     NORMALIZE_MODE,
     NORMALIZE_TYPE,
     UP_AXIS,
+    CLEANUP_KIND,
 }
 _NUMERIC_KINDS = {
     NUMBER,

@@ -130,7 +130,7 @@ Lot --> extrude(height) report("h", height)
 def test_what_bgr_lacks_is_reported_at_its_place_and_left_out(tmp_path):
     out, result = _import(
         tmp_path,
-        """Lot --> mirror(true, false, false)
+        """Lot --> setPivot(xyz, 0)
     extrude(10)
     comp(f) { front: Front | side: Side }
 Front --> comp(e) { all: Edge }
@@ -139,7 +139,7 @@ Edge --> color(1, 0, 0)
 """,
     )
     found = {(w.line, w.column): w.message for w in result.warnings}
-    assert "mirror" in found[(1, 9)]
+    assert "setPivot" in found[(1, 9)]
     assert "comp(e)" in found[(4, 11)]
     assert "envelope" in found[(5, 10)]
     assert any(line == 5 and "inside" in m for (line, _), m in found.items())

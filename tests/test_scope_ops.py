@@ -116,3 +116,52 @@ def test_rotate_scope_then_insert_fits_the_turned_scope():
     assert np.allclose(_axes(result)[0], [0, 0, -1], atol=1e-9)
     assert result.terminals.size[0] == pytest.approx([1.0, 2.5, 4.0])  # y: the mean of x and z
     assert np.allclose(result.mesh.bounds, [[0, 0, 0], [4, 2.5, 1]], atol=1e-9)
+
+
+def test_mirror_flips_the_geometry_inside_its_scope():
+    # the reference's example: mirror(true, false, false) flips an L left to right; the scope
+    # stays where it was
+    plain = _derive("terminal A\nLot --> footprint(L, 0.4, 0.5) extrude(3) A", lot=(10.0, 8.0))
+    flipped = _derive(
+        "terminal A\nLot --> footprint(L, 0.4, 0.5) mirror(true, false, false) extrude(3) A",
+        lot=(10.0, 8.0),
+    )
+    assert np.allclose(plain.mesh.bounds, flipped.mesh.bounds)
+    assert flipped.mesh.center_mass[0] == pytest.approx(10.0 - plain.mesh.center_mass[0])
+    assert flipped.mesh.volume == pytest.approx(plain.mesh.volume)
+    assert np.allclose(flipped.terminals.origin, plain.terminals.origin)
+    # a mesh: mirrored along y, its triangles still face out (a positive volume)
+    wedge = _derive("terminal W\nLot --> s(2, 2, 2) i(wedge) mirror(false, true, false) W")
+    assert wedge.mesh.volume == pytest.approx(4.0)  # half the 2 m cube, facing out
+    upright = _derive("terminal W\nLot --> s(2, 2, 2) i(wedge) W")
+    assert wedge.mesh.center_mass[1] == pytest.approx(2.0 - upright.mesh.center_mass[1])
+    with pytest.raises(bgr.BgrError, match="true or false"):
+        _derive("Lot --> mirror(1, 0, 0)")
+
+
+def test_cleanup_geometry_merges_near_points_and_leaves_exact_shapes_alone(tmp_path):
+    # an outline with a point 1 cm from the next: cleanupGeometry(all, 0.05) drops it
+    text = (
+        "version 1\nterminal A\n"
+        "Lot --> polygon(0, 0, 10, 0, 10.01, 0, 10, 8, 0, 8) CLEAN extrude(3) A"
+    )
+    plain = bgr.derive(bgr.load(text.replace("CLEAN ", "")), lot=(10.0, 8.0))
+    clean = bgr.derive(
+        bgr.load(text.replace("CLEAN", "cleanupGeometry(all, 0.05)")), lot=(10.0, 8.0)
+    )
+    assert len(clean.mesh.faces) < len(plain.mesh.faces)
+    assert clean.mesh.volume == pytest.approx(plain.mesh.volume, rel=1e-3)
+    # an inserted mesh with a duplicated corner 1 mm away: merged, its sliver face dropped
+    obj = tmp_path / "sliver.obj"
+    obj.write_text("v 0 0 0\nv 1 0 0\nv 1 1 0\nv 1.001 1 0\nf 1 2 3\nf 2 4 3\n", encoding="utf-8")
+    grammar = 'version 1\nasset s = "sliver.obj"\nterminal A\nLot --> s(1, 1, 1) i(s) CLEAN A'
+    (tmp_path / "a.bgr").write_text(grammar.replace("CLEAN ", ""), encoding="utf-8")
+    (tmp_path / "b.bgr").write_text(grammar.replace("CLEAN", "cleanupGeometry(all, 0.01)"))
+    raw = bgr.derive(bgr.load(tmp_path / "a.bgr"))
+    cleaned = bgr.derive(bgr.load(tmp_path / "b.bgr"))
+    assert len(raw.mesh.faces) == 2 and len(cleaned.mesh.faces) == 1
+    # exact shapes are left as they are
+    box = "version 1\nterminal A\nLot --> extrude(3) CLEAN A"
+    a = bgr.derive(bgr.load(box.replace("CLEAN ", "")))
+    b = bgr.derive(bgr.load(box.replace("CLEAN", "cleanupGeometry(all, 0.1)")))
+    assert np.array_equal(a.mesh.faces, b.mesh.faces)

@@ -29,6 +29,8 @@ IMPLEMENTATIONS = {
     "rotateScope": scopes.rotate_scope,
     "alignScopeToAxes": scopes.align_scope_to_axes,
     "alignScopeToGeometry": scopes.align_scope_to_geometry,
+    "mirror": scopes.mirror,
+    "cleanupGeometry": scopes.cleanup_geometry,
     "split": splits.split,
     "comp": components.comp,
     "offset": components.offset,

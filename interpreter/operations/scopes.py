@@ -21,7 +21,7 @@ from ..geometry.meshes import PLANE_AXES, flat_mesh, prism_mesh
 from ..geometry.polygons import RECT
 from ..shapes import IDENTITY, Flat, Prism, Solid, cross, dot, normalise
 from ..terminals import UnitMesh
-from .transforms import _amounts, _rotate_axes
+from .transforms import _amounts, _mirror, _rotate_axes
 
 Frame = tuple[tuple[float, float, float], ...]
 
@@ -219,3 +219,101 @@ def _solid(app, shape, frame: Frame, verts, tris, name: str, uv, image) -> None:
     shape.axes = tuple(tuple(float(c) for c in a) for a in frame)
     shape.size = [float(s) for s in size]
     shape.geom = Solid(mesh_id, name)
+
+
+def mirror(app, shape, step, args) -> bool:
+    """CGA's mirror(xFlip, yFlip, zFlip): the geometry mirrored inside its scope, which stays.
+
+    A flip along a 2D shape's flat axis, or along a prism's extrusion, changes nothing (the shape
+    is symmetric that way); a mesh mirrored an odd number of times turns its triangles round so
+    that they keep facing out."""
+    flips = args[:3]
+    for value in flips:
+        if not isinstance(value, bool):
+            raise runtime_error(app.module, step.pos, "mirror() takes true or false for each axis")
+    geom = shape.geom
+    if isinstance(geom, (Flat, Prism)):
+        polys = geom.polys
+        if polys == RECT:
+            return False
+        for which, axis in enumerate(PLANE_AXES[geom.k]):
+            if flips[axis]:
+                polys = [
+                    (_mirror(ext, which), tuple(_mirror(h, which) for h in holes))
+                    for ext, holes in polys
+                ]
+        shape.geom = type(geom)(geom.k, polys, geom.name)
+        return False
+    if not any(flips):
+        return False
+    library = app.engine.table.library
+    mesh = library.meshes[geom.mesh]
+    verts = mesh.vertices.copy()
+    faces, uv = mesh.faces, mesh.uv
+    for axis in range(3):
+        if flips[axis]:
+            verts[:, axis] = 1.0 - verts[:, axis]
+    if sum(flips) % 2:
+        faces = faces[:, ::-1].copy()
+        uv = uv[:, ::-1].copy() if uv is not None else None
+    shape.geom = Solid(library.add(UnitMesh(mesh.name, verts, faces, uv, mesh.image)), geom.name)
+    return False
+
+
+def cleanup_geometry(app, shape, step, args) -> bool:
+    """CGA's cleanupGeometry(components, tolerance): points closer than ``tolerance`` metres
+    merged, faces left without area dropped.  bgr's own shapes are exact, so this changes
+    imported meshes and outlines made of near-duplicate points; ``components`` (CGA's all,
+    faces, edges, vertices) is read as all."""
+    tolerance = args[1]
+    if isinstance(tolerance, bool) or not isinstance(tolerance, (int, float)):
+        raise runtime_error(app.module, step.pos, "cleanupGeometry()'s tolerance is a number")
+    if tolerance <= 0:
+        return False
+    geom = shape.geom
+    if isinstance(geom, (Flat, Prism)):
+        if geom.polys == RECT:
+            return False
+        p, q = PLANE_AXES[geom.k]
+        su, sv = shape.size[p], shape.size[q]
+        polys = []
+        for ext, holes in geom.polys:
+            outer = _thinned(ext, su, sv, tolerance)
+            if outer is None:
+                continue
+            kept_holes = [r for r in (_thinned(h, su, sv, tolerance) for h in holes) if r]
+            polys.append((outer, tuple(kept_holes)))
+        if polys:
+            shape.geom = type(geom)(geom.k, polys, geom.name)
+        return False
+    library = app.engine.table.library
+    mesh = library.meshes[geom.mesh]
+    metres = mesh.vertices * np.asarray(shape.size)
+    keys = np.round(metres / tolerance).astype(np.int64)
+    _, first, inverse = np.unique(keys, axis=0, return_index=True, return_inverse=True)
+    faces = inverse.reshape(-1)[mesh.faces]
+    good = (
+        (faces[:, 0] != faces[:, 1]) & (faces[:, 1] != faces[:, 2]) & (faces[:, 0] != faces[:, 2])
+    )
+    if good.all() and len(first) == len(mesh.vertices):
+        return False
+    uv = mesh.uv[good] if mesh.uv is not None else None
+    cleaned = UnitMesh(mesh.name, mesh.vertices[first], faces[good], uv, mesh.image)
+    shape.geom = Solid(library.add(cleaned), geom.name)
+    return False
+
+
+def _thinned(ring, su: float, sv: float, tolerance: float):
+    """A unit ring without points closer than ``tolerance`` metres to the last one kept; None
+    when fewer than three are left."""
+    out: list = []
+    for u, v in ring:
+        if out and math.hypot((u - out[-1][0]) * su, (v - out[-1][1]) * sv) < tolerance:
+            continue
+        out.append((u, v))
+    if (
+        len(out) > 1
+        and math.hypot((out[0][0] - out[-1][0]) * su, (out[0][1] - out[-1][1]) * sv) < tolerance
+    ):
+        out.pop()
+    return tuple(out) if len(out) >= 3 else None
