@@ -39,6 +39,10 @@ SAME_NAMES = {
     "geometry.nVertices",
     "geometry.nFaces",
     "geometry.height",
+    "geometry.nEdges",
+    "geometry.nHoles",
+    "geometry.boundaryLength",
+    "geometry.isConcave",
 }
 # CGA functions whose result has this type when bgr has no equivalent: the neutral value stands in
 _BOOLEAN = {
@@ -46,8 +50,6 @@ _BOOLEAN = {
     "overlaps",
     "touches",
     "fileExists",
-    "geometry.isConcave",
-    "geometry.isPlanar",
     "geometry.isClosedSurface",
     "geometry.isOriented",
     "geometry.isInside",

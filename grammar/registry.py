@@ -241,7 +241,8 @@ OPERATIONS: dict[str, Op] = {
             "offset",
             "components",
             _sig(Param("distance", NUMBER)),
-            "Inset a 2D face by a distance (a negative one grows it) into an inside and a border.",
+            "Inset a 2D face by a distance (a negative one grows it) into an inside and a border; "
+            "a solid, each of its faces.",
             "offset(0.2) { inside: Glass | border: Frame }",
             block="offset",
         ),
@@ -600,6 +601,37 @@ BUILTINS: dict[str, Builtin] = {
             "geometry.height()",
             "the extent of the shape's geometry along the world's vertical, in metres.",
         ),
+        Builtin("geometry.nEdges", 0, 0, "geometry.nEdges()", "the distinct edges (a box: 12)."),
+        Builtin(
+            "geometry.nHoles",
+            0,
+            0,
+            "geometry.nHoles()",
+            "the holes in the faces of the shape's geometry (a courtyard lot: 1).",
+        ),
+        Builtin(
+            "geometry.boundaryLength",
+            0,
+            0,
+            "geometry.boundaryLength()",
+            "the length of the edges only one face has: a 2D shape's outline with its holes', "
+            "0 for a closed solid.",
+        ),
+        Builtin(
+            "geometry.isConcave",
+            0,
+            0,
+            "geometry.isConcave()",
+            "true when a face of the shape's geometry is concave or has a hole.",
+        ),
+        Builtin(
+            "geometry.isPlanar",
+            0,
+            1,
+            "geometry.isPlanar(tolerance)",
+            "true when all the faces of the shape's geometry lie in one plane, within tolerance "
+            "degrees (default 0).",
+        ),
     ]
 }
 
@@ -632,6 +664,10 @@ BUILTIN_NAMES: dict[str, str] = {
     "geometry.nVertices": "geometry.nVertices(), written bare",
     "geometry.nFaces": "geometry.nFaces(), written bare",
     "geometry.height": "geometry.height(), written bare",
+    "geometry.nEdges": "geometry.nEdges(), written bare",
+    "geometry.nHoles": "geometry.nHoles(), written bare",
+    "geometry.boundaryLength": "geometry.boundaryLength(), written bare",
+    "geometry.isConcave": "geometry.isConcave(), written bare",
     "seed": "the global seed",
 }
 

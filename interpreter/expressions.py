@@ -215,7 +215,17 @@ _MATH = {
 
 # CGA's geometry functions that measure the shape's geometry (interpreter/geometry/queries.py)
 _GEOMETRY_QUERIES = frozenset(
-    ("geometry.area", "geometry.volume", "geometry.nVertices", "geometry.nFaces", "geometry.height")
+    (
+        "geometry.area",
+        "geometry.volume",
+        "geometry.nVertices",
+        "geometry.nFaces",
+        "geometry.height",
+        "geometry.nEdges",
+        "geometry.nHoles",
+        "geometry.boundaryLength",
+        "geometry.isConcave",
+    )
 )
 
 
@@ -501,6 +511,11 @@ class Compiler:
 
             query = QUERIES[name]
             return lambda ctx: query(ctx.shape, ctx.library)
+        if name == "geometry.isPlanar":
+            from .geometry.queries import is_planar
+
+            tol = args[0] if args else (lambda ctx: 0.0)
+            return lambda ctx: is_planar(ctx.shape, ctx.library, _num(module, pos, tol(ctx)))
         if name == "geometry.isRectangular":
             tolerance = args[0] if args else (lambda ctx: 1.0)
             return lambda ctx: is_rectangular(ctx.shape, _num(module, pos, tolerance(ctx)))

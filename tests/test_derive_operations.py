@@ -89,3 +89,23 @@ def test_colour_material_and_label_reach_the_terminal_list(tmp_path):
     )
     assert src  # the deleted variant derives to nothing
     assert len(bgr.derive(bgr.load(src))) == 0
+
+
+def test_offset_of_a_solid_offsets_each_face():
+    # CGA offsets every face of a 3D shape: a box's six faces each get a frame and an inside
+    import bgr
+
+    grammar = bgr.load(
+        "version 1\nterminal In, Frame\n"
+        "Lot --> s(4, 2, 3) i(cube) offset(0.5) { inside: In | border: Frame }"
+    )
+    result = bgr.derive(grammar, lot=(10.0, 10.0))
+    labels = list(result.terminals.label)
+    assert labels.count("In") == 6 and labels.count("Frame") == 6
+    inside = sorted(
+        tuple(sorted(round(float(v), 6) for v in result.terminals.size[k][:2]))
+        for k, label in enumerate(labels)
+        if label == "In"
+    )
+    # faces 4 x 2, 4 x 3 and 2 x 3 (twice each), each 0.5 m in from every edge
+    assert inside == [(1.0, 2.0)] * 2 + [(1.0, 3.0)] * 2 + [(2.0, 3.0)] * 2

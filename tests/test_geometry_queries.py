@@ -83,3 +83,20 @@ def test_written_without_brackets_as_cga_allows():
     assert measured(source, lot=(10, 20)) == {"Large": [200.0, 1.0, 1.0]}
     with pytest.raises(bgr.BgrCheckError, match="only known while deriving a shape"):
         bgr.load("attr a = geometry.area\nLot --> NIL\n")
+
+
+def test_edges_holes_boundary_concavity_and_planarity():
+    # a 10 x 20 lot and its box, and an L: CGA's nEdges, nHoles, boundaryLength, isConcave and
+    # isPlanar of each
+    sizes = measured(
+        "Lot --> [ Flat ] [ extrude(5) Box ] [ footprint(L, 0.4, 0.5) Ell ]\n"
+        "Flat --> s(geometry.nEdges(), geometry.boundaryLength(), geometry.nHoles()) "
+        "label(str(geometry.isPlanar()) + str(geometry.isConcave())) F\n"
+        "Box --> s(geometry.nEdges, geometry.boundaryLength + 1, geometry.nHoles + 1) "
+        "label(str(geometry.isPlanar(1)) + str(geometry.isConcave)) B\n"
+        "Ell --> s(geometry.nEdges(), 1, 1) label(str(geometry.isConcave())) L\n"
+        "terminal F, B, L\n"
+    )
+    assert sizes["truefalse"] == [4.0, 60.0, 0.0]  # the lot: 4 edges, 60 m round, planar
+    assert sizes["falsefalse"] == [12.0, 1.0, 1.0]  # the box: 12 edges, closed, no holes
+    assert sizes["true"] == [6.0, 1.0, 1.0]  # the L: 6 edges, concave

@@ -86,3 +86,82 @@ QUERIES = {
     "geometry.nFaces": n_faces,
     "geometry.height": height,
 }
+
+
+def _face_rings(shape, library) -> list:
+    """The geometry's planar faces: (rings in scope metres, outer first; normal)."""
+    verts, faces = scope_mesh(shape, library)
+    return planar_faces(verts, faces) if len(faces) else []
+
+
+def _edges(shape, library) -> dict:
+    """Each undirected edge of the faces' outlines (rounded end points) and how many faces
+    share it."""
+    seen: dict = {}
+    for rings, _ in _face_rings(shape, library):
+        for ring in rings:
+            pts = [tuple(round(float(c), 6) for c in p) for p in ring]
+            for a, b in zip(pts, pts[1:] + pts[:1], strict=True):
+                key = (a, b) if a <= b else (b, a)
+                seen[key] = seen.get(key, 0) + 1
+    return seen
+
+
+def n_edges(shape, library) -> int:
+    """The geometry's distinct edges (a box: 12)."""
+    return len(_edges(shape, library))
+
+
+def n_holes(shape, library) -> int:
+    """The holes in the geometry's faces (a courtyard footprint: 1; extruded, 2: top and
+    bottom)."""
+    return sum(len(rings) - 1 for rings, _ in _face_rings(shape, library))
+
+
+def boundary_length(shape, library) -> float:
+    """The length of the edges that only one face has: a 2D shape's outline (with its holes'),
+    0 for a closed solid."""
+    total = 0.0
+    for (a, b), used in _edges(shape, library).items():
+        if used == 1:
+            total += float(np.linalg.norm(np.subtract(a, b)))
+    return total
+
+
+def is_concave(shape, library) -> bool:
+    """Whether a face of the geometry is concave (a hole makes it so), as CGA's."""
+    for rings, normal in _face_rings(shape, library):
+        if len(rings) > 1:
+            return True
+        ring = np.asarray(rings[0], dtype=np.float64)
+        edges = np.roll(ring, -1, axis=0) - ring
+        turns = np.cross(edges, np.roll(edges, -1, axis=0)) @ np.asarray(normal, dtype=np.float64)
+        if bool((turns > 1e-9).any() and (turns < -1e-9).any()):
+            return True
+    return False
+
+
+def is_planar(shape, library, tolerance: float = 0.0) -> bool:
+    """Whether all the geometry's faces lie in one plane, normals within ``tolerance``
+    degrees of each other (and their points on one plane)."""
+    faces = _face_rings(shape, library)
+    if not faces:
+        return True
+    first = np.asarray(faces[0][1], dtype=np.float64)
+    limit = np.cos(np.radians(max(float(tolerance), 0.0))) - 1e-9
+    points = np.asarray([p for rings, _ in faces for ring in rings for p in ring])
+    offsets = (points - points[0]) @ first
+    span = float(np.ptp(points, axis=0).max()) or 1.0
+    parallel = all(float(np.dot(first, n)) >= limit for _, n in faces)
+    slack = span * float(np.sin(np.radians(max(float(tolerance), 0.0)))) + 1e-6
+    return bool(parallel and float(np.abs(offsets).max()) <= slack)
+
+
+QUERIES.update(
+    {
+        "geometry.nEdges": n_edges,
+        "geometry.nHoles": n_holes,
+        "geometry.boundaryLength": boundary_length,
+        "geometry.isConcave": is_concave,
+    }
+)

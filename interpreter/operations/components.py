@@ -291,12 +291,18 @@ def _pieces(polys, su: float, sv: float, distance: float) -> dict:
 
 
 def offset(app, shape, step, args) -> bool:
+    if not isinstance(shape.geom, Flat):
+        # a solid: each of its faces is offset in its own plane, as CGA offsets every face
+        faces = _faces(app, step, shape)
+        for rings, nrm, _ in faces:
+            _offset_flat(app, _face_shape(shape, rings, nrm), step, args)
+        return True
+    return _offset_flat(app, shape, step, args)
+
+
+def _offset_flat(app, shape, step, args) -> bool:
     distance = float(args[0])
     geom = shape.geom
-    if not isinstance(geom, Flat):
-        raise runtime_error(
-            app.module, step.pos, "offset() needs a 2D shape", "use it on a face from comp(f)"
-        )
     p, q = PLANE_AXES[geom.k]
     su, sv = shape.size[p], shape.size[q]
     if geom.polys == RECT:
