@@ -116,6 +116,8 @@ def neutral(name: str) -> n.Expr:
     """What stands in for a value bgr cannot compute: false, "" or 0 by the kind of name."""
     if name == "colorRamp":  # a colour from a ramp: a mid grey stands in
         return n.String("#808080")
+    if name in ("geometry.du", "geometry.dv"):  # texture-space extents, often divided by
+        return n.Number(1.0)
     short = name.rsplit(".", 1)[-1]
     if name in _BOOLEAN or short.startswith("is"):
         return n.Bool(False)
@@ -288,4 +290,4 @@ def _show(e: n.Expr) -> str:
         return "false"
     if isinstance(e, n.String):
         return f'"{e.value}"'
-    return "0"
+    return f"{e.value:g}" if isinstance(e, n.Number) else "0"

@@ -19,7 +19,7 @@ from ..grammar.errors import BgrError, Diagnostic
 from ..grammar.loader import decode
 from ..grammar.paths import read_input
 from ..grammar.registry import KEYWORDS, PRIMITIVES
-from .parse import parse
+from .parse import parse_lenient
 from .translate import Translator
 
 READABLE_MESHES = (".obj", ".glb", ".gltf", ".ply", ".stl", ".off")
@@ -196,7 +196,8 @@ def translate_file(source: Path, output: Path) -> Imported:
 
     def one(src: Path, out: Path) -> None:
         text = read_cga(src)
-        tree, comments = parse(text, str(src))
+        tree, comments, unread = parse_lenient(text, str(src))
+        result.warnings += unread
         assets = Assets(src.parent, out.parent)
         busy.append(src.resolve())
 

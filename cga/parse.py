@@ -7,6 +7,7 @@ the formatter to put back beside the translated code.
 
 from __future__ import annotations
 
+import re
 import threading
 from pathlib import Path
 
@@ -83,7 +84,7 @@ def _syntax_error(e: UnexpectedInput, text: str, path: str) -> BgrSyntaxError:
     line, column = getattr(e, "line", 0) or 0, getattr(e, "column", 0) or 0
     if isinstance(e, UnexpectedToken):
         tok = e.token
-        what = "the end of the file" if tok.type == "$END" else f"'{tok}'"
+        what = "end of the file" if tok.type == "$END" else f"'{tok}'"
         expected = sorted(e.accepts or e.expected)
         hint = "expected one of: " + ", ".join(_describe(x) for x in expected[:8])
         message = f"unexpected {what}"
@@ -127,3 +128,60 @@ _WORDS = {
 
 def _describe(terminal: str) -> str:
     return _WORDS.get(terminal, terminal.lower())
+
+
+_ITEM_START = re.compile(r"[^\s#/@*]")  # a line that starts an item: not indented, no comment
+
+
+def parse_lenient(text: str, path: str = "<text>"):
+    """Parse CGA text, leaving out each top-level item (a rule, an attr, a function) that does
+    not parse: its lines are blanked and a warning says where and why.  Returns (tree, comments,
+    warnings); a file in which no item can be read at all raises the first syntax error."""
+    text = normalise_newlines(text)
+    lines = text.split("\n")
+    warnings: list[Diagnostic] = []
+    first_error: BgrSyntaxError | None = None
+    for _ in range(200):
+        try:
+            tree, comments = parse("\n".join(lines), path)
+            if first_error is not None and not tree.children:
+                raise first_error  # nothing could be read
+            return tree, comments, warnings
+        except BgrSyntaxError as e:
+            first_error = first_error or e
+            d = e.diagnostics[0]
+            span = _item_span(lines, d.line)
+            if span is None:
+                raise first_error from None
+            start, end = span
+            warnings.append(
+                Diagnostic(
+                    path,
+                    d.line,
+                    d.column,
+                    f"{d.message}: the item on lines {start + 1}-{end + 1} is left out",
+                    d.hint,
+                    source_line(text, d.line),
+                    severity="warning",
+                )
+            )
+            for k in range(start, end + 1):
+                lines[k] = ""
+    raise first_error or BgrSyntaxError(Diagnostic(path, 0, 0, "the file does not parse"))
+
+
+def _item_span(lines: list[str], line: int) -> tuple[int, int] | None:
+    """The (first, last) 0-based lines of the top-level item around 1-based ``line``: from the
+    last line at or above it that starts an item, to the line before the next one."""
+    at = min(max(line, 1), len(lines)) - 1
+    start = at
+    while start > 0 and not _ITEM_START.match(lines[start]):
+        start -= 1
+    if not lines[start].strip():
+        return None
+    end = at + 1
+    while end < len(lines) and not (
+        _ITEM_START.match(lines[end]) and not lines[end].startswith(("}", "|", ")", "]"))
+    ):
+        end += 1
+    return start, max(start, end - 1)

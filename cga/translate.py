@@ -84,6 +84,8 @@ class Translator:
         self.extra: list[n.Rule] = []
         self.helpers = 0
         self.start: str | None = None
+        self.seen_names: set = set()
+        self.skipped: set[int] = set()  # items declared a second time
 
     # ---- diagnostics -----------------------------------------------------------------------
     def warn(self, meta, message: str, hint: str | None = None) -> None:
@@ -124,6 +126,8 @@ class Translator:
                 style = True
             if style:
                 continue
+            if kind in ("rule", "func_decl", "attr_decl", "const_decl") and self.again(item):
+                continue
             if kind == "rule" and "." not in str(item.children[0]):
                 name, params = str(item.children[0]), _names(item.children[1])
                 self.arities.setdefault(name, set()).add(len(params))
@@ -142,6 +146,22 @@ class Translator:
             for k, arity in enumerate(sorted(arities)):
                 bgr = name if k == 0 else f"{name}_{arity}"
                 self.rules[(name, arity)] = self.fresh(bgr, OPERATIONS)
+
+    def again(self, item: Tree) -> bool:
+        """Whether ``item`` declares again what an earlier one did (a rule of the same name and
+        arity, a value or function of the same name): it is left out, with a warning."""
+        name = str(item.children[0])
+        key = (
+            ("rule", name, len(_names(item.children[1])))
+            if item.data == "rule"
+            else ("value", name)
+        )
+        if key in self.seen_names:
+            self.skipped.add(id(item))
+            self.warn(item.meta, f"'{name}' is declared a second time; this one is left out")
+            return True
+        self.seen_names.add(key)
+        return False
 
     def value(self, name: str, meta) -> n.Expr | None:
         if name in self.params:
@@ -206,11 +226,14 @@ class Translator:
                     "redefines is left out (the default style is translated)",
                 )
                 continue
-            if style is not None:
+            if style is not None or id(item) in self.skipped:
+                notes = []
                 continue
             if kind == "annotation":
                 note = self.annotation(item)
-                if note is not None:
+                if note is not None and any(a.name == note.name for a in notes):
+                    self.warn(item.meta, f"@{note.name} is given twice; the second is left out")
+                elif note is not None:
                     notes.append(note)
                 continue
             if kind == "version_decl":
