@@ -17,7 +17,7 @@ from typing import Protocol
 from lark import Token, Tree
 
 from ..grammar import nodes as n
-from ..grammar.registry import BUILTINS
+from ..grammar.registry import BUILTIN_NAMES, BUILTINS
 
 # CGA's scope and context names with a bgr twin of another name (the rest keep theirs)
 NAMES = {
@@ -25,25 +25,8 @@ NAMES = {
     "scope.ty": "scope.y",
     "scope.tz": "scope.z",
 }
-SAME_NAMES = {
-    "scope.sx",
-    "scope.sy",
-    "scope.sz",
-    "split.index",
-    "split.total",
-    "comp.index",
-    "comp.total",
-    "comp.sel",
-    "geometry.area",
-    "geometry.volume",
-    "geometry.nVertices",
-    "geometry.nFaces",
-    "geometry.height",
-    "geometry.nEdges",
-    "geometry.nHoles",
-    "geometry.boundaryLength",
-    "geometry.isConcave",
-}
+# the scope, split, comp and geometry names bgr has under CGA's names
+SAME_NAMES = {name for name in BUILTIN_NAMES if "." in name}
 # CGA functions whose result has this type when bgr has no equivalent: the neutral value stands in
 _BOOLEAN = {
     "inside",

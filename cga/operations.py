@@ -218,21 +218,6 @@ def split(tr: Translator, args: list, block: Tree, meta) -> list:
     return _with_block(tr, "split", [n.Name(axis)], tr.block(block, "split"), meta)
 
 
-COMP_SELECTORS = {
-    "front",
-    "back",
-    "left",
-    "right",
-    "side",
-    "top",
-    "bottom",
-    "vertical",
-    "horizontal",
-    "aslant",
-    "all",
-}
-
-
 def comp(tr: Translator, args: list, block: Tree, meta) -> list:
     kind = _word(args[0]) if args else None
     if kind != "f":

@@ -28,7 +28,7 @@ from lark import Token, Tree
 from ..grammar import nodes as n
 from ..grammar.annotations import SPECS
 from ..grammar.errors import Diagnostic, source_line
-from ..grammar.registry import BUILTIN_NAMES, BUILTINS, KEYWORDS, OPERATIONS
+from ..grammar.registry import BUILTIN_NAMES, BUILTINS, COMP_SELECTORS, KEYWORDS, OPERATIONS
 from . import operations as ops
 from .expressions import Expressions, dotted, pos, unquote
 from .start import At, prepend_to_start, shape_attrs
@@ -544,7 +544,7 @@ class Translator:
             keys = [w for w in words if w is not None and w not in named]
             named.update(keys)
             return [n.Name(w) for w in keys]
-        if word in ops.COMP_SELECTORS:
+        if word in COMP_SELECTORS:
             return [n.Name(word)]
         if isinstance(t, Tree) and t.data == "number":
             return [n.Call("face", [n.Number(float(str(t.children[0])))])]

@@ -15,6 +15,7 @@ from typing import Any
 
 from bgr.grammar import nodes as n
 from bgr.grammar.errors import BgrError, Diagnostic, source_line
+from bgr.grammar.registry import BUILTIN_NAMES
 
 from .randomness import Stream, child_hash, name_hash, root_hash
 
@@ -214,19 +215,7 @@ _MATH = {
 
 
 # CGA's geometry functions that measure the shape's geometry (interpreter/geometry/queries.py)
-_GEOMETRY_QUERIES = frozenset(
-    (
-        "geometry.area",
-        "geometry.volume",
-        "geometry.nVertices",
-        "geometry.nFaces",
-        "geometry.height",
-        "geometry.nEdges",
-        "geometry.nHoles",
-        "geometry.boundaryLength",
-        "geometry.isConcave",
-    )
-)
+_GEOMETRY_QUERIES = frozenset(name for name in BUILTIN_NAMES if name.startswith("geometry."))
 
 
 class Compiler:
