@@ -26,6 +26,7 @@ from ..grammar.registry import (
     TEX_SIZE,
     UP_AXES,
 )
+from . import media
 from .expressions import dotted, pos, unquote
 
 if TYPE_CHECKING:
@@ -305,17 +306,17 @@ def insert(tr: Translator, args: list, meta, rest: list) -> Steps:
     if not args:
         tr.warn(meta, "i() needs a geometry; it is left out")
         return [], False
-    geometry = tr.asset_of(args[0], meta)
+    geometry = media.asset_of(tr, args[0], meta)
     if geometry is not None:
         return [n.Operation("i", [geometry], pos=where)], False
     # a path computed at derive time (a rule parameter): one branch per asset the file names
-    return tr.dispatch_insert(args[0], meta, rest), True
+    return media.dispatch_insert(tr, args[0], meta, rest), True
 
 
 def texture(tr: Translator, op: str, args: list, meta) -> list:
     if not args:
         return []
-    path = tr.texture_path(args[0], meta)
+    path = media.texture_path(tr, args[0], meta)
     return [] if path is None else [n.Operation(op, [path], pos=pos(meta))]
 
 

@@ -18,7 +18,6 @@ Everything else is dropped with a warning at its line and column (:attr:`Transla
 
 from __future__ import annotations
 
-import copy
 import re
 import unicodedata
 from collections.abc import Callable
@@ -29,11 +28,11 @@ from ..grammar import nodes as n
 from ..grammar.annotations import SPECS
 from ..grammar.errors import Diagnostic, source_line
 from ..grammar.registry import BUILTIN_NAMES, BUILTINS, COMP_SELECTORS, KEYWORDS, OPERATIONS
+from . import media
 from . import operations as ops
 from .expressions import Expressions, dotted, pos, unquote
 from .start import At, prepend_to_start, shape_attrs
 
-GEOMETRY_FILES = (".obj", ".glb", ".gltf", ".fbx", ".dae", ".ply", ".stl", ".3ds")
 EMPTY = "t"  # a step that changes nothing: a sequence CGA leaves empty keeps its shape as a leaf
 
 
@@ -273,7 +272,7 @@ class Translator:
             notes = []
         self.drop_notes(notes, "the end of the file")
         items = shape_attrs(self, items, attrs, consts)
-        if self.inserts():  # CGA's trim planes are on from the start; bgr's wait for this
+        if media.inserts(self):  # CGA's trim planes are on from the start; bgr's wait for this
             trim_on = n.Operation("set", [n.Name("trim.vertical"), n.Bool(True)])
             items = prepend_to_start(self, items, [trim_on])
         # the declarations bgr wants up front stand on the version's line, so that comments
@@ -552,78 +551,6 @@ class Translator:
             meta, f"comp(f) selector '{word or 'this'}' is not in bgr yet; its faces are left out"
         )
         return []
-
-    # ---- assets and textures ---------------------------------------------------------------
-    def asset_of(self, t, meta) -> n.Expr | None:
-        text = ops.literal_string(t)
-        if text is None and ops._word(t) in self.consts:
-            text = self._const_text(ops._word(t))
-        if text is None:
-            return None
-        return self.assets.geometry(text, meta, self.warn)
-
-    def _const_text(self, name: str | None) -> str | None:
-        for item in self.tree.children:
-            if item.data == "const_decl" and str(item.children[0]) == name:
-                return ops.literal_string(item.children[2])
-        return None
-
-    def dispatch_insert(self, t, meta, rest: list) -> list:
-        value = self.expr(t)
-        tail = self.steps(rest)
-        choices: dict[str, n.Expr] = {}
-        for text in sorted(self.file_strings(GEOMETRY_FILES, builtin=True)):
-            choices[text] = self.assets.geometry(text, meta, self.warn)
-        kinds = {ops_key(g) for g in choices.values()} | {"cube"}
-        if len(kinds) == 1:
-            return [n.Operation("i", [n.Name("cube")], pos=pos(meta))] + tail
-        cases = [
-            n.Case(
-                n.Binary("==", value, n.String(text)),
-                n.Sequence([n.Operation("i", [g])] + copy.deepcopy(tail)),
-            )
-            for text, g in choices.items()
-        ]
-        cases.append(n.Case(None, n.Sequence([n.Operation("i", [n.Name("cube")])] + tail)))
-        return [self.helper(n.Conditional(cases), pos(meta))]
-
-    def texture_path(self, t, meta) -> n.Expr | None:
-        text = ops.literal_string(t)
-        if text is None and ops._word(t) in self.consts:
-            text = self._const_text(ops._word(t))
-        if text is not None:
-            return self.assets.texture(text, meta, self.warn)
-        images = self.file_strings((".jpg", ".jpeg", ".png", ".tif", ".tiff", ".tga", ".bmp"))
-        prefix = self.assets.texture_prefix(images)
-        if prefix is None:
-            self.warn(
-                meta,
-                "texture() of a computed path: not every image the file names was "
-                "found beside it (as PNG or JPEG), so it is left out",
-            )
-            return None
-        value = self.expr(t)
-        return n.Binary("+", n.String(prefix), value) if prefix else value
-
-    def inserts(self) -> bool:
-        """Whether the file inserts anything (i(), primitiveCube()...): trim planes cut that."""
-        names = {"i", *ops.PRIMITIVES}
-        return any(
-            dotted(t.children[0]) in names
-            for t in self.tree.find_pred(lambda t: t.data in ("call", "successor"))
-        )
-
-    def file_strings(self, suffixes: tuple, builtin: bool = False) -> set[str]:
-        out = set()
-        for tok in self.tree.scan_values(lambda v: isinstance(v, Token) and v.type == "STRING"):
-            text = unquote(tok)
-            if text.lower().endswith(suffixes) or (builtin and text.startswith("builtin:")):
-                out.add(text)
-        return out
-
-
-def ops_key(e: n.Expr) -> str:
-    return e.name if isinstance(e, n.Name) else repr(e)
 
 
 def _names(t) -> list[str]:
