@@ -61,6 +61,7 @@ SAME = {
     "alignScopeToGeometry",
     "mirror",
     "cleanupGeometry",
+    "convexify",
 }
 # operations some of whose arguments are bare words
 WORDS_TAKEN = (
@@ -77,7 +78,6 @@ PRIMITIVES = {
 BUILTIN_ASSETS = {"cube": "cube", "cylinder": "cylinder", "sphere": "sphere", "quad": "quad"}
 # operations that change the shape in a way bgr cannot yet: dropped, the shape goes on as it was
 DROPPED = {
-    "convexify",
     "envelope",
     "mirrorScope",
     "trim",

@@ -25,7 +25,7 @@ CGA: list[tuple[str, str, str, str]] = [
     ("cleanupGeometry", SAME, "", ""),
     ("color", SAME, "", ""),
     ("comp", PARTLY, "", "faces (`comp(f)`) with their selectors; edges and vertices not yet"),
-    ("convexify", NOT_YET, "", ""),
+    ("convexify", PARTLY, "", "2D shapes; a solid's faces not yet"),
     ("deleteHoles", NOT_YET, "", ""),
     ("deleteUV", SAME, "", ""),
     ("envelope", NOT_YET, "", ""),

@@ -211,6 +211,15 @@ OPERATIONS: dict[str, Op] = {
             "cleanupGeometry(all, 0.01)",
         ),
         Op(
+            "convexify",
+            "transforms",
+            ((), (Param("maxLength", NUMBER),)),
+            "Cut a 2D shape's polygons into convex parts (its comp(f) then gives each as a "
+            "face), as CGA's convexify; cuts longer than `maxLength` metres are not made, so a "
+            "part may stay concave.",
+            "convexify() comp(f) { all: Part }",
+        ),
+        Op(
             "matrix",
             "transforms",
             (_MATRIX,),

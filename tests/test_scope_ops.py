@@ -165,3 +165,28 @@ def test_cleanup_geometry_merges_near_points_and_leaves_exact_shapes_alone(tmp_p
     a = bgr.derive(bgr.load(box.replace("CLEAN ", "")))
     b = bgr.derive(bgr.load(box.replace("CLEAN", "cleanupGeometry(all, 0.1)")))
     assert np.array_equal(a.mesh.faces, b.mesh.faces)
+
+
+def test_convexify_cuts_a_concave_outline_into_convex_faces():
+    # the reference's example: convexify(maxLength) comp(f) { all: SubShapes }; an L and a U
+    def parts(text):
+        result = _derive("terminal P\nLot --> " + text + " comp(f) { all: P }", lot=(20.0, 15.0))
+        return result, len(result)
+
+    whole = _derive("terminal P\nLot --> footprint(U, 0.3, 0.4) P", lot=(20.0, 15.0))
+    u, count = parts("footprint(U, 0.3, 0.4) convexify()")
+    assert count == 3 and u.mesh.area == pytest.approx(whole.mesh.area)
+    # each part is convex: geometry.isConcave of each face says so
+    flags = _derive(
+        "terminal P\nLot --> footprint(U, 0.3, 0.4) convexify() comp(f) { all: "
+        "label(str(geometry.isConcave())) P }",
+        lot=(20.0, 15.0),
+    )
+    assert set(flags.terminals.label) == {"false"}
+    _, l_count = parts("footprint(L, 0.3, 0.4) convexify()")
+    assert l_count == 2
+    # no cut is longer than 5 m here: the U stays one (concave) part
+    _, kept = parts("footprint(U, 0.3, 0.4) convexify(5)")
+    assert kept == 1
+    _, box = parts("convexify()")  # a rectangle is convex already
+    assert box == 1

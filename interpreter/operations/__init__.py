@@ -31,6 +31,7 @@ IMPLEMENTATIONS = {
     "alignScopeToGeometry": scopes.align_scope_to_geometry,
     "mirror": scopes.mirror,
     "cleanupGeometry": scopes.cleanup_geometry,
+    "convexify": scopes.convexify,
     "split": splits.split,
     "comp": components.comp,
     "offset": components.offset,

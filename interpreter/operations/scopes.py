@@ -16,6 +16,7 @@ import math
 import numpy as np
 
 from ..expressions import runtime_error
+from ..geometry.convex import convex_parts
 from ..geometry.frames import _ccw, flat_points, reframe_flat
 from ..geometry.meshes import PLANE_AXES, flat_mesh, prism_mesh
 from ..geometry.polygons import RECT
@@ -317,3 +318,26 @@ def _thinned(ring, su: float, sv: float, tolerance: float):
     ):
         out.pop()
     return tuple(out) if len(out) >= 3 else None
+
+
+def convexify(app, shape, step, args) -> bool:
+    """CGA's convexify(maxLength): a 2D shape's polygons cut into convex parts (its comp(f)
+    gives each as a face); cuts longer than ``maxLength`` metres are not made."""
+    geom = shape.geom
+    if not isinstance(geom, Flat):
+        raise runtime_error(
+            app.module,
+            step.pos,
+            "convexify() of a solid is not in bgr yet",
+            "convexify a 2D shape: a lot, or a face from comp(f)",
+        )
+    if geom.polys == RECT:
+        return False
+    limit = args[0] if len(args) > 1 else math.inf
+    if isinstance(limit, bool) or not isinstance(limit, (int, float)):
+        raise runtime_error(app.module, step.pos, "convexify()'s maxLength is a number")
+    p, q = PLANE_AXES[geom.k]
+    parts = convex_parts(geom.polys, shape.size[p], shape.size[q], float(limit))
+    if parts:
+        shape.geom = Flat(geom.k, parts, geom.name)
+    return False
