@@ -96,7 +96,6 @@ DROPPED = {
     "shapeL",
     "shapeU",
     "shapeO",
-    "setback",
     "innerRectangle",
     "innerRect",
     "splitArea",
@@ -124,6 +123,16 @@ def operation(tr: Translator, name: str, args: list, block, meta, rest: list) ->
         ), False
     if name == "offset":
         return offset(tr, args, meta, rest)
+    if name == "setback" and block is not None and len(args) == 1 and not _is_fcall_block(args[0]):
+        body = tr.block(block, "setback")
+        return _with_block(tr, "setback", [tr.expr(args[0])], body, meta), True
+    if name == "setback":
+        tr.warn(
+            meta,
+            "setback() with a distance per edge (comp(fe) { ... }) is not in bgr yet; "
+            "its shape is dropped (NIL)",
+        )
+        return [n.Nil(pos=where)], True
     if name in ROOFS:
         return roof(tr, name, args, meta), False
     if name in PRIMITIVES:
@@ -229,6 +238,13 @@ def comp(tr: Translator, args: list, block: Tree, meta) -> list:
         )
         return [n.Nil(pos=pos(meta))]
     return _with_block(tr, "comp", [n.Name("f")], tr.block(block, "comp"), meta)
+
+
+def _is_fcall_block(t) -> bool:
+    """``comp(fe) { front = 3 | ... }``: distances per edge, which bgr's setback does not take."""
+    return isinstance(t, Tree) and any(
+        isinstance(c, Tree) and c.data == "fcall_block" for c in t.iter_subtrees()
+    )
 
 
 def _with_block(tr: Translator, name: str, args: list, block: n.Block | None, meta) -> list:

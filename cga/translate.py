@@ -27,7 +27,14 @@ from lark import Token, Tree
 from ..grammar import nodes as n
 from ..grammar.annotations import SPECS
 from ..grammar.errors import Diagnostic, source_line
-from ..grammar.registry import BUILTIN_NAMES, BUILTINS, COMP_SELECTORS, KEYWORDS, OPERATIONS
+from ..grammar.registry import (
+    BUILTIN_NAMES,
+    BUILTINS,
+    COMP_SELECTORS,
+    KEYWORDS,
+    OPERATIONS,
+    SETBACK_SELECTORS,
+)
 from . import media
 from . import operations as ops
 from .expressions import Expressions, dotted, pos, unquote
@@ -543,6 +550,11 @@ class Translator:
             keys = [w for w in words if w is not None and w not in named]
             named.update(keys)
             return [n.Name(w) for w in keys]
+        if kind == "setback":
+            if word in SETBACK_SELECTORS:
+                return [n.Name(word)]
+            self.warn(meta, f"setback selector '{word or 'this'}' is not in bgr yet; left out")
+            return []
         if word in COMP_SELECTORS:
             return [n.Name(word)]
         if isinstance(t, Tree) and t.data == "number":

@@ -62,7 +62,13 @@ CGA: list[tuple[str, str, str, str]] = [
         "",
         "attrs; `set(material.name, v)` is `material(v)`; other shape attributes not yet",
     ),  # fmt: skip
-    ("setback", NOT_YET, "", ""),
+    (
+        "setback",
+        PARTLY,
+        "",
+        "one distance, the scope's edge selectors, side, all and remainder; a distance per "
+        "edge, street and uv selectors not yet",
+    ),
     ("setNormals", NOT_YET, "", ""),
     ("setPivot", NOT_YET, "", ""),
     ("setupProjection", SAME, "", ""),

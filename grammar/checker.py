@@ -50,6 +50,7 @@ from .registry import (
     PROJECTION_AXES_NAMES,
     ROOF_KIND,
     ROOF_KINDS,
+    SETBACK_SELECTORS,
     SHAPE_ATTRIBUTES,
     SIZE,
     STRING,
@@ -628,7 +629,9 @@ class Checker:
             self.sequence(entry.body, local)
 
     def selector(self, entry: n.Entry, op: Op, local: set[str]) -> None:
-        allowed = COMP_SELECTORS if op.block == "comp" else OFFSET_SELECTORS
+        allowed = {"comp": COMP_SELECTORS, "setback": SETBACK_SELECTORS}.get(
+            op.block or "", OFFSET_SELECTORS
+        )
         key = entry.key
         if entry.kind != "abs":
             self.error(

@@ -55,6 +55,7 @@ COMP_SELECTORS = (
     "all",
 )
 OFFSET_SELECTORS = ("inside", "border")
+SETBACK_SELECTORS = ("front", "back", "left", "right", "top", "bottom", "side", "all", "remainder")
 PROJECTION_AXES_NAMES = tuple(
     f"{frame}.{a}{b}" for frame in ("scope", "world") for a in "xyz" for b in "xyz" if a != b
 )
@@ -92,7 +93,7 @@ class Op:
     signatures: tuple[tuple[Param, ...], ...]
     doc: str
     example: str
-    block: str | None = None  # None, or the kind of block it takes: split | comp | offset
+    block: str | None = None  # None, or the kind of block: split | comp | offset | setback
     more: Param | None = None  # what any number of further arguments are (polygon's corners)
 
     def arities(self) -> list[tuple[int, int]]:
@@ -254,6 +255,16 @@ OPERATIONS: dict[str, Op] = {
             "a solid, each of its faces.",
             "offset(0.2) { inside: Glass | border: Frame }",
             block="offset",
+        ),
+        Op(
+            "setback",
+            "components",
+            _sig(Param("distance", NUMBER)),
+            "Set some edges of a 2D shape in by a distance, as CGA's setback: each selected "
+            "edge's strip (`front`, `back`, `left`, `right`, `top`, `bottom`: by its outward "
+            "normal in the scope's quadrants; `side`, `all`) is a piece, `remainder` the rest.",
+            "setback(3) { front: Yard | remainder: Building }",
+            block="setback",
         ),
         Op(
             "footprint",

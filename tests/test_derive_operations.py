@@ -109,3 +109,36 @@ def test_offset_of_a_solid_offsets_each_face():
     )
     # faces 4 x 2, 4 x 3 and 2 x 3 (twice each), each 0.5 m in from every edge
     assert inside == [(1.0, 2.0)] * 2 + [(1.0, 3.0)] * 2 + [(2.0, 3.0)] * 2
+
+
+def test_setback_sets_edges_in_as_cga_does():
+    # the reference's example: setback(3) { front: Yard | remainder: Building }; each selected
+    # edge's strip is a piece, corners going to the edge that comes first round the outline
+    import bgr
+
+    grammar = bgr.load(
+        "version 1\nterminal Yard, Side, Rest\n"
+        "Lot --> setback(3) { front: Yard | side: Side | remainder: Rest }"
+    )
+    result = bgr.derive(grammar, lot=(20.0, 15.0))
+    pieces = [
+        (label, [round(float(v), 6) for v in result.terminals.size[k]])
+        for k, label in enumerate(result.terminals.label)
+    ]
+    assert pieces == [
+        ("Yard", [20.0, 0.0, 3.0]),
+        ("Side", [3.0, 0.0, 12.0]),
+        ("Side", [17.0, 0.0, 3.0]),
+        ("Side", [3.0, 0.0, 9.0]),
+        ("Rest", [14.0, 0.0, 9.0]),
+    ]
+    assert result.mesh.area == pytest.approx(20 * 15)
+    # an L: the strip follows the outline, the remainder is what is left
+    l_shape = bgr.load(
+        "version 1\nterminal Strip, Rest\n"
+        "Lot --> footprint(L, 0.5, 0.5) setback(1) { all: Strip | remainder: Rest }"
+    )
+    done = bgr.derive(l_shape, lot=(10.0, 10.0))
+    labels = list(done.terminals.label)
+    assert labels.count("Strip") == 6 and labels.count("Rest") == 1
+    assert done.mesh.area == pytest.approx(75.0)

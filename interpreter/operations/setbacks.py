@@ -1,0 +1,72 @@
+"""setback(distance) { selector: ... | remainder: ... }: CGA's setback of a 2D shape's edges
+(interpreter/geometry/setbacks.py holds the geometry)."""
+
+from __future__ import annotations
+
+from bgr.grammar import nodes as n
+
+from ..expressions import runtime_error
+from ..geometry.meshes import PLANE_AXES
+from ..geometry.polygons import RECT, UNIT_SQUARE, is_unit_square
+from ..geometry.polygons import normalise as normalise_polys
+from ..geometry.setbacks import edge_kinds, strips
+from ..shapes import Flat
+
+_SIDES = ("left", "right", "front", "back")
+
+
+def setback(app, shape, step, args) -> bool:
+    distance = float(args[0])
+    geom = shape.geom
+    if not isinstance(geom, Flat):
+        raise runtime_error(
+            app.module,
+            step.pos,
+            "setback() needs a 2D shape",
+            "set back the edges of a lot, or of a face from comp(f)",
+        )
+    if distance <= 0:
+        raise runtime_error(app.module, step.pos, f"setback() distance {distance:g} is not > 0")
+    p, q = PLANE_AXES[geom.k]
+    su, sv = shape.size[p], shape.size[q]
+    polys = [(UNIT_SQUARE, ())] if geom.polys == RECT else geom.polys
+    edges = edge_kinds(polys, su, sv, p, q)
+    taken = [False] * len(edges)
+    chosen: list[tuple[n.Entry, list[int]]] = []
+    for entry in step.block.entries:
+        word = entry.key.name
+        if word == "remainder":
+            continue
+        picked = [
+            i
+            for i, (_, kind) in enumerate(edges)
+            if not taken[i]
+            and (word == "all" or word == kind or (word == "side" and kind in _SIDES))
+        ]
+        for i in picked:
+            taken[i] = True
+        chosen.append((entry, picked))
+    order = sorted(i for _, picked in chosen for i in picked)
+    parts, rest = strips(polys, su, sv, [edges[i][0] for i in order], distance)
+    part_of = dict(zip(order, parts, strict=True))
+    for entry, picked in chosen:
+        for i in picked:
+            _piece(app, shape, step, entry, part_of[i], p, q, geom.k)
+    for entry in step.block.entries:
+        if entry.key.name == "remainder":
+            _piece(app, shape, step, entry, rest, p, q, geom.k)
+    return True
+
+
+def _piece(app, shape, step, entry, metric_polys, p: int, q: int, k: int) -> None:
+    if not metric_polys:
+        return
+    unit, (x0, y0, w, h) = normalise_polys(metric_polys)
+    piece = shape.copy().cut_from(shape)
+    move = [0.0, 0.0, 0.0]
+    move[p], move[q] = x0, y0
+    piece.origin = shape.world(move)
+    piece.size[p], piece.size[q] = w, h
+    piece.geom = Flat(k, RECT if is_unit_square(unit) else unit)
+    app.engine.count_shape(app.module, entry.pos)
+    app.piece(piece, entry.body)
