@@ -142,3 +142,6 @@ def test_setback_sets_edges_in_as_cga_does():
     labels = list(done.terminals.label)
     assert labels.count("Strip") == 6 and labels.count("Rest") == 1
     assert done.mesh.area == pytest.approx(75.0)
+    # a distance of 0 sets nothing back: the remainder is the whole shape
+    zero = bgr.load("version 1\nterminal S, R\nLot --> setback(0) { all: S | remainder: R }")
+    assert list(bgr.derive(zero, lot=(10.0, 10.0)).terminals.label) == ["R"]

@@ -42,7 +42,7 @@ def strips(polys, su: float, sv: float, edges: list[tuple], distance: float) -> 
     whole = to_shapely(metric(polys, su, sv))
     taken = shapely.Polygon()
     parts = []
-    for a, b in edges:
+    for a, b in edges if distance > 0 else []:
         length = math.hypot(b[0] - a[0], b[1] - a[1])
         tx, ty = (b[0] - a[0]) / length, (b[1] - a[1]) / length
         ix, iy = -ty, tx  # inward
@@ -55,6 +55,8 @@ def strips(polys, su: float, sv: float, edges: list[tuple], distance: float) -> 
         piece = whole.intersection(band).difference(taken)
         taken = taken.union(piece)
         parts.append(from_shapely(piece))
+    if distance <= 0:  # nothing is set back: no strips, the whole shape remains
+        parts = [[] for _ in edges]
     return parts, from_shapely(whole.difference(taken))
 
 

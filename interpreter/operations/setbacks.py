@@ -25,8 +25,10 @@ def setback(app, shape, step, args) -> bool:
             "setback() needs a 2D shape",
             "set back the edges of a lot, or of a face from comp(f)",
         )
-    if distance <= 0:
-        raise runtime_error(app.module, step.pos, f"setback() distance {distance:g} is not > 0")
+    if distance < 0:
+        raise runtime_error(
+            app.module, step.pos, f"setback() distance {distance:g} is negative", "grow with offset"
+        )
     p, q = PLANE_AXES[geom.k]
     su, sv = shape.size[p], shape.size[q]
     polys = [(UNIT_SQUARE, ())] if geom.polys == RECT else geom.polys
