@@ -328,3 +328,29 @@ def test_whatever_is_read_is_written_as_a_grammar_that_checks(tmp_path_factory, 
         bgr.derive(grammar, lot=(10.0, 10.0), max_shapes=2000)
     except BgrError as e:
         assert e.diagnostics[0].line > 0 or e.diagnostics[0].message
+
+
+def test_imports_are_followed_and_translated_beside_the_grammar(tmp_path):
+    (tmp_path / "windows.cga").write_text(
+        "attr frame = 0.1\nWindow --> offset(-frame) comp(f) { inside: Glass | border: Frame }\n"
+        "Glass --> color(0, 0, 1)\nFrame --> color(1, 1, 1)\n",
+        encoding="utf-8",
+    )
+    out, result = _import(
+        tmp_path,
+        'import win : "windows.cga"\n'
+        "Lot --> extrude(3) comp(f) { front: win.Window | side: Wall }\n"
+        "Wall --> color(0.5, 0.5, 0.5)\n",
+    )
+    assert result.warnings == []
+    assert 'import "windows.bgr" as win' in out.read_text()
+    assert (out.parent / "windows.bgr").is_file()
+    assert _labels(_derive(out)) == {"Glass": 1, "Frame": 1, "Wall": 3}
+    # a missing import: its rules become leaves, with a warning at the import's line
+    out2, result2 = _import(
+        tmp_path,
+        'import roof : "/ESRI.lib/rules/Roofs/Roof_Textures.cga"\nLot --> roof.Generate\n',
+        name="other.cga",
+    )
+    assert [w.line for w in result2.warnings] == [1]
+    assert _labels(_derive(out2)) == {"roof_Generate": 1}
