@@ -191,6 +191,8 @@ class Expressions:
             return found
         if name == "pow" and len(args) == 2:
             return n.Binary("**", args[0], args[1])
+        if name == "find" and len(args) == 2:  # the first occurrence
+            args.append(n.Number(0.0))
         return n.Call(name, args)
 
     def _fcall_block(self, t: Tree) -> n.Expr:

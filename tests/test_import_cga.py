@@ -354,3 +354,11 @@ def test_imports_are_followed_and_translated_beside_the_grammar(tmp_path):
     )
     assert [w.line for w in result2.warnings] == [1]
     assert _labels(_derive(out2)) == {"roof_Generate": 1}
+
+
+def test_find_with_two_arguments_finds_the_first(tmp_path):
+    out, result = _import(
+        tmp_path, 'attr zone = "Urban Corridor"\nLot --> report("at", find(zone, "Corridor"))\n'
+    )
+    assert result.warnings == [] and 'find(zone, "Corridor", 0)' in out.read_text()
+    assert _derive(out).reports[0]["reports"]["at"]["sum"] == 6.0
