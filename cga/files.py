@@ -185,6 +185,7 @@ class Imported:
 
     outputs: dict[Path, str] = field(default_factory=dict)
     warnings: list[Diagnostic] = field(default_factory=list)
+    attrs: dict[Path, dict[str, str]] = field(default_factory=dict)  # CGA name -> bgr name
 
 
 def translate_file(source: Path, output: Path) -> Imported:
@@ -201,7 +202,7 @@ def translate_file(source: Path, output: Path) -> Imported:
         assets = Assets(src.parent, out.parent)
         busy.append(src.resolve())
 
-        def resolve_import(target: str, meta) -> str | None:
+        def resolve_import(target: str, meta) -> tuple[str, dict] | None:
             found = find(target, src.parent)
             line, column = getattr(meta, "line", 0), getattr(meta, "column", 0)
             if found is None:
@@ -240,7 +241,7 @@ def translate_file(source: Path, output: Path) -> Imported:
                     Diagnostic(**{**d.__dict__, "severity": "warning"}) for d in e.diagnostics
                 ]
                 return None
-            return target_out.name
+            return target_out.name, result.attrs[target_out]
 
         tr = Translator(tree, comments, text, str(src), assets, resolve_import)
         module = tr.module()
@@ -257,6 +258,7 @@ def translate_file(source: Path, output: Path) -> Imported:
                 )
             )
         result.outputs[out] = format_module(module)
+        result.attrs[out] = dict(tr.attrs)
         result.warnings += tr.warnings
 
     one(source, output)

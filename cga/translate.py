@@ -70,7 +70,7 @@ class Translator:
         text: str,
         path: str,
         assets,
-        imports: Callable[[str, object], str | None],
+        imports: Callable[[str, object], tuple[str, dict] | None],
     ) -> None:
         self.tree, self.comments, self.text, self.path = tree, comments, text, path
         self.assets, self.resolve_import = assets, imports
@@ -91,6 +91,7 @@ class Translator:
         self.helpers = 0
         self.start: str | None = None
         self.seen_names: set = set()
+        self.bindings: list[n.Operation] = []  # imports' attribute bindings, as set()s
         self.skipped: set[int] = set()  # items declared a second time
 
     # ---- diagnostics -----------------------------------------------------------------------
@@ -278,6 +279,8 @@ class Translator:
                 self.extra = []
             notes = []
         self.drop_notes(notes, "the end of the file")
+        if self.bindings:  # after the attrs that read the shape (prepended next) are set
+            items = prepend_to_start(self, items, self.bindings)
         items = shape_attrs(self, items, attrs, consts)
         if media.inserts(self):  # CGA's trim planes are on from the start; bgr's wait for this
             trim_on = n.Operation("set", [n.Name("trim.vertical"), n.Bool(True)])
@@ -342,19 +345,34 @@ class Translator:
             )
             return
         alias, target, bindings = str(t.children[0]), unquote(t.children[1]), t.children[2]
-        if bindings is not None:
-            self.warn(
-                bindings.meta if hasattr(bindings, "meta") else t.meta,
-                "import with attribute bindings is not in bgr yet; the imported file's own "
-                "defaults are used",
-            )
-        bgr_path = self.resolve_import(target, t.meta)
-        if bgr_path is None:
+        found = self.resolve_import(target, t.meta)
+        if found is None:
             self.imports[alias] = None
             return
+        bgr_path, their_attrs = found
         name = self.fresh(alias, ("scope", "split", "comp", "stdlib"))
         self.imports[alias] = name
         items.append(n.Import(name, path=bgr_path, pos=pos(t.meta)))
+        for binding in bindings.children if bindings is not None else []:
+            self.bind(name, binding, their_attrs)
+
+    def bind(self, alias: str, binding: Tree, their_attrs: dict) -> None:
+        """An import's attribute binding ``(height = Eave_Ht)``: ``set(alias.height, Eave_Ht)``
+        when the start rule begins (``height`` alone binds the importer's attr of that name)."""
+        attr = str(binding.children[0])
+        if attr not in their_attrs:
+            self.warn(binding.meta, f"the imported file has no attr '{attr}'; binding left out")
+            return
+        value = (
+            self.expr(binding.children[1])
+            if len(binding.children) > 1
+            else self.value(attr, binding.meta)
+        )
+        if value is None:
+            self.warn(binding.meta, f"'{attr}' is not an attr here; binding left out")
+            return
+        target = n.Name(f"{alias}.{their_attrs[attr]}")
+        self.bindings.append(n.Operation("set", [target, value]))
 
     def func(self, t: Tree) -> n.Func:
         name, params = str(t.children[0]), _names(t.children[1])

@@ -148,7 +148,13 @@ CGA: list[tuple[str, str, str, str]] = [
     ("attr", SAME, "attr name = value", ""),
     ("case / else", DIFFERENT, "case c: A | else: B", "branches separated by `|`"),
     ("const", SAME, "const name = value", ""),
-    ("import", DIFFERENT, 'import "file.bgr" as name', "then `name.Rule`"),
+    (
+        "import",
+        DIFFERENT,
+        'import "file.bgr" as name',
+        "then `name.Rule`; a binding `(attr = v)` is `set(name.attr, v)` (import-cga); rule "
+        "overrides not yet",
+    ),
     ("scope.sx, scope.sy, scope.sz", SAME, "scope.sx, scope.sy, scope.sz", ""),
     ("scope.tx, scope.ty, scope.tz", DIFFERENT, "scope.x, scope.y, scope.z", ""),
     (

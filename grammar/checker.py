@@ -491,14 +491,24 @@ class Checker:
             self.error(arg.pos, "set() changes an attr: name it bare", f"for example: {op.example}")
         elif arg.name in SHAPE_ATTRIBUTES:
             return
+        elif "." in arg.name and arg.name.split(".", 1)[0] in self.g.imports:
+            module, member = self.g.lookup_module(arg.name)
+            if member in module.attrs:
+                module.settable.add(member)  # its rules read the value set() gave
+            else:
+                self.error(
+                    arg.pos,
+                    f"unknown attr '{arg.name}'",
+                    suggest(member, list(module.attrs)) or "set() changes attrs of that file",
+                )
+        elif "." in arg.name and arg.name.split(".", 1)[0] in self.broken_aliases:
+            return
         elif arg.name in self.g.consts:
             self.error(arg.pos, f"'{arg.name}' is a const: set() changes attrs only")
         elif arg.name in self.g.attrs:
             self.g.settable.add(arg.name)
         else:
-            hint = "set() changes this file's own attrs (declare it: attr NAME = value)"
-            if "." in arg.name:
-                hint = "set() changes this file's own attrs, not an imported file's"
+            hint = "set() changes this file's attrs (declare it: attr NAME = value) or an import's"
             self.error(
                 arg.pos,
                 f"unknown attr '{arg.name}'",

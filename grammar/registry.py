@@ -361,7 +361,8 @@ OPERATIONS: dict[str, Op] = {
             "set",
             "attributes",
             _sig(Param("attribute", ATTR_NAME), Param("value", VALUE)),
-            "Set an attr of this file for the shape and every shape derived from it, as CGA's "
+            "Set an attr of this file (or `alias.attr` of an imported one) for the shape and "
+            "every shape derived from it, as CGA's "
             "set(): rules below read the new value, the rest of the lot the old one (attrs "
             "computed from it keep theirs). `set(trim.vertical, true)` turns CGA's trim planes "
             "on for the shape's subtree (`false` off).",

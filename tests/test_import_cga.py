@@ -333,7 +333,7 @@ def test_whatever_is_read_is_written_as_a_grammar_that_checks(tmp_path_factory, 
 def test_imports_are_followed_and_translated_beside_the_grammar(tmp_path):
     (tmp_path / "windows.cga").write_text(
         "attr frame = 0.1\nWindow --> offset(-frame) comp(f) { inside: Glass | border: Frame }\n"
-        "Glass --> color(0, 0, 1)\nFrame --> color(1, 1, 1)\n",
+        'Glass --> report("frame", frame) color(0, 0, 1)\nFrame --> color(1, 1, 1)\n',
         encoding="utf-8",
     )
     out, result = _import(
@@ -345,7 +345,18 @@ def test_imports_are_followed_and_translated_beside_the_grammar(tmp_path):
     assert result.warnings == []
     assert 'import "windows.bgr" as win' in out.read_text()
     assert (out.parent / "windows.bgr").is_file()
-    assert _labels(_derive(out)) == {"Glass": 1, "Frame": 1, "Wall": 3}
+    derived = _derive(out)
+    assert _labels(derived) == {"Glass": 1, "Frame": 1, "Wall": 3}
+    assert derived.reports[0]["reports"]["frame"]["sum"] == pytest.approx(0.1)
+    # with an attribute binding: the imported attr takes the importer's value
+    out3, result3 = _import(
+        tmp_path,
+        'attr border = 0.3\nimport win : "windows.cga" (frame = border * 2)\n'
+        "Lot --> extrude(3) comp(f) { front: win.Window }\n",
+        name="bound.cga",
+    )
+    assert result3.warnings == [] and "set(win.frame, border * 2)" in out3.read_text()
+    assert _derive(out3).reports[0]["reports"]["frame"]["sum"] == pytest.approx(0.6)
     # a missing import: its rules become leaves, with a warning at the import's line
     out2, result2 = _import(
         tmp_path,

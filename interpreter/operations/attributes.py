@@ -33,7 +33,8 @@ def set_attr(app, shape, step, args) -> bool:
             elif shape.trims is None:
                 shape.trims = ()  # on: the next comp(f) of a solid makes planes
         return False
-    key = (id(app.module), name)
+    module, member = app.module.lookup_module(name)  # an imported file's attr: alias.name
+    key = (id(module), member)
     values = dict(shape.attrs or ())
     values[key] = value
     shape.attrs = tuple(sorted(values.items()))
