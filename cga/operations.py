@@ -178,9 +178,15 @@ def same(tr: Translator, name: str, args: list, meta) -> list:
         tr.warn(meta, "color()'s alpha is left out (set material.opacity is not in bgr yet)")
         args = args[:3]
     if name == "r" and args and _word(args[0]) in ("scopeCenter", "scopeOrigin"):
-        if _word(args[0]) == "scopeCenter":
-            tr.warn(meta, "r(scopeCenter, ...) turns about the scope's origin in bgr")
-        args = args[1:]
+        centre = _word(args[0]) == "scopeCenter"
+        turn = same(tr, "r", args[1:], meta)
+        if not centre or not turn:
+            return turn
+        # about the scope's centre: to the centre, turn, and back along the turned axes
+        half = [n.Relative(n.Number(0.5)) for _ in range(3)]
+        back = [n.Relative(n.Number(-0.5)) for _ in range(3)]
+        where = pos(meta)
+        return [n.Operation("t", half, pos=where), *turn, n.Operation("t", back, pos=where)]
     word = _word(args[0]) if args else None
     if name == "extrude" and word is not None and word.startswith(("world.", "face.", "vertex.")):
         if word not in ("world.up", "face.normal"):

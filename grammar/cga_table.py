@@ -42,7 +42,13 @@ CGA: list[tuple[str, str, str, str]] = [
     ("primitiveCube", DIFFERENT, "i(cube)", "also `cylinder`, `sphere`, `quad`, `wedge`"),
     ("print", SAME, "", "on standard error, each lot's in derivation order"),
     ("projectUV", SAME, "", ""),
-    ("r", PARTLY, "", "about the scope's origin; `r(scopeCenter, ...)` not yet"),
+    (
+        "r",
+        PARTLY,
+        "",
+        "about the scope's origin; import-cga writes `r(scopeCenter, x, y, z)` as "
+        "`t('0.5, '0.5, '0.5) r(x, y, z) t('-0.5, '-0.5, '-0.5)`",
+    ),
     ("report", SAME, "", "each lot's values summed up per key; `bgr derive --reports`"),
     ("resetMaterial", NOT_YET, "", ""),
     ("reverseNormals", SAME, "", ""),

@@ -11,6 +11,7 @@ import subprocess
 import sys
 from pathlib import Path
 
+import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
@@ -373,3 +374,14 @@ def test_find_with_two_arguments_finds_the_first(tmp_path):
     )
     assert result.warnings == [] and 'find(zone, "Corridor", 0)' in out.read_text()
     assert _derive(out).reports[0]["reports"]["at"]["sum"] == 6.0
+
+
+def test_r_about_the_scope_centre_turns_in_place(tmp_path):
+    # CGA's r(scopeCenter, 0, 90, 0): a 4 x 2 box turned about its centre keeps that centre
+    out, result = _import(
+        tmp_path, 'Lot --> s(4, 1, 2) i("builtin:cube") r(scopeCenter, 0, 90, 0) Box\n'
+    )
+    assert result.warnings == []
+    bounds = _derive(out).mesh.bounds
+    assert np.allclose(bounds.mean(axis=0)[[0, 2]], [2.0, 1.0])  # the centre stays
+    assert np.allclose(bounds[1] - bounds[0], [2.0, 1.0, 4.0])  # turned a quarter
