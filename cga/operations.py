@@ -138,7 +138,13 @@ def operation(tr: Translator, name: str, args: list, block, meta, rest: list) ->
     if name in PRIMITIVES:
         steps: list = []
         if len(args) == 3:
-            steps.append(n.Operation("s", [tr.expr(a) for a in args], pos=where))
+            sizes = [tr.expr(a) for a in args]
+            if all(isinstance(e, n.Number) and e.value >= 0 for e in sizes):
+                steps.append(n.Operation("s", sizes, pos=where))
+            else:  # a negative size extends the box the other way from the scope's origin
+                low = [n.Call("min", [copy.deepcopy(e), n.Number(0.0)]) for e in sizes]
+                steps.append(n.Operation("t", low, pos=where))
+                steps.append(n.Operation("s", [n.Call("abs", [e]) for e in sizes], pos=where))
         return steps + [n.Operation("i", [n.Name(PRIMITIVES[name])], pos=where)], False
     if name == "i":
         return insert(tr, args, meta, rest)

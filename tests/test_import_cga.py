@@ -385,3 +385,9 @@ def test_r_about_the_scope_centre_turns_in_place(tmp_path):
     bounds = _derive(out).mesh.bounds
     assert np.allclose(bounds.mean(axis=0)[[0, 2]], [2.0, 1.0])  # the centre stays
     assert np.allclose(bounds[1] - bounds[0], [2.0, 1.0, 4.0])  # turned a quarter
+
+
+def test_primitive_cube_of_negative_size_extends_the_other_way(tmp_path):
+    out, result = _import(tmp_path, "attr w = -2\nLot --> t(5, 0, 5) primitiveCube(w, 1, 3) Box\n")
+    assert result.warnings == []
+    assert np.allclose(_derive(out).mesh.bounds, [[3, 0, 5], [5, 1, 8]])
