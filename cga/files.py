@@ -20,7 +20,8 @@ from ..grammar.loader import decode
 from ..grammar.paths import read_input
 from ..grammar.registry import KEYWORDS, PRIMITIVES
 from .parse import parse_lenient
-from .translate import Translator
+from .styles import style_blocks, style_module
+from .translate import Translator, ascii_name
 
 READABLE_MESHES = (".obj", ".glb", ".gltf", ".ply", ".stl", ".off")
 READABLE_IMAGES = (".png", ".jpg", ".jpeg")
@@ -259,6 +260,15 @@ def translate_file(source: Path, output: Path) -> Imported:
             )
         result.outputs[out] = format_module(module)
         result.attrs[out] = dict(tr.attrs)
+        rules = module.rules()
+        for decl, items in style_blocks(tree):
+            if not rules:
+                tr.warn(decl.meta, f"style '{decl.children[0]}': the file has no rules to run")
+                continue
+            start = tr.start or rules[0].name
+            styled = style_module(tr, decl, items, out.name, start)
+            styled_out = out.with_name(f"{out.stem}.{ascii_name(str(decl.children[0]))}.bgr")
+            result.outputs[styled_out] = format_module(styled)
         result.warnings += tr.warnings
 
     one(source, output)

@@ -226,12 +226,7 @@ class Translator:
         for item in self.tree.children:
             kind = item.data
             if kind == "style_decl":
-                style = item
-                self.warn(
-                    item.meta,
-                    f"style '{item.children[0]}' is not in bgr yet; what it "
-                    "redefines is left out (the default style is translated)",
-                )
+                style = item  # written as a grammar of its own (styles.py)
                 continue
             if style is not None or id(item) in self.skipped:
                 notes = []

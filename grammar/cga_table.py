@@ -170,6 +170,13 @@ CGA: list[tuple[str, str, str, str]] = [
         "and the others",
     ),
     ("@StartRule", DIFFERENT, "start Name", "or the first rule; the annotation is kept too"),
+    (
+        "style",
+        DIFFERENT,
+        'import "file.bgr" as base',
+        "import-cga writes each style as a grammar that sets the attrs it redefines "
+        "(`set(base.attr, v)`) and runs the file's start rule",
+    ),
 ]
 
 # registry entries CGA has no word for: bgr's own

@@ -391,3 +391,26 @@ def test_primitive_cube_of_negative_size_extends_the_other_way(tmp_path):
     out, result = _import(tmp_path, "attr w = -2\nLot --> t(5, 0, 5) primitiveCube(w, 1, 3) Box\n")
     assert result.warnings == []
     assert np.allclose(_derive(out).mesh.bounds, [[3, 0, 5], [5, 1, 8]])
+
+
+def test_a_style_becomes_a_grammar_that_sets_the_attrs_it_redefines(tmp_path):
+    out, result = _import(
+        tmp_path,
+        """attr wall = "#888888"
+attr h = 6
+Lot --> extrude(h) color(wall) Mass
+style Red
+attr wall = "#cc0000"
+attr h = h * 2
+Lot --> NIL
+""",
+    )
+    styled = out.with_name("rules.Red.bgr")
+    assert styled.is_file()
+    text = styled.read_text()
+    assert 'set(base.wall, "#cc0000")' in text and "set(base.h, base.h * 2)" in text
+    assert [w.line for w in result.warnings] == [7]  # a rule in a style: left out, said where
+    plain, red = _derive(out), _derive(styled)
+    assert np.allclose(plain.terminals.color[0], [0x88 / 255] * 3, atol=1e-3)
+    assert np.allclose(red.terminals.color[0], [0xCC / 255, 0, 0], atol=1e-3)
+    assert red.terminals.size[0][1] == pytest.approx(12.0)
