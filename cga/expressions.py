@@ -17,7 +17,7 @@ from typing import Protocol
 from lark import Token, Tree
 
 from ..grammar import nodes as n
-from ..grammar.registry import BUILTIN_NAMES, BUILTINS
+from ..grammar.registry import BUILTIN_NAMES, BUILTINS, COMP_SELECTORS
 
 # CGA's scope and context names with a bgr twin of another name (the rest keep theirs)
 NAMES = {
@@ -171,6 +171,17 @@ class Expressions:
 
     def _fcall(self, t: Tree) -> n.Expr:
         name = dotted(t.children[0])
+        if name == "geometry.area" and t.children[1] is not None:
+            arg = t.children[1].children[0]
+            word = dotted(arg.children[0]) if isinstance(arg, Tree) and arg.data == "name" else None
+            if word in COMP_SELECTORS:
+                return n.Call(name, [n.Name(word)])
+            self.ctx.warn(
+                t.meta,
+                "geometry.area() of this selector is not in bgr yet; the "
+                "whole geometry's area stands in",
+            )
+            return n.Call(name, [])
         if name.startswith("geometry.") and name in BUILTINS and BUILTINS[name].most == 0:
             if t.children[1] is not None:
                 self.ctx.warn(

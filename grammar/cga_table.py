@@ -113,7 +113,7 @@ CGA: list[tuple[str, str, str, str]] = [
     ("float", SAME, "", ""),
     ("floor", SAME, "", ""),
     ("geometry.angle", NOT_YET, "", ""),
-    ("geometry.area", PARTLY, "", "with or without brackets; face selectors not yet"),
+    ("geometry.area", SAME, "", "with or without brackets; the comp(f) face selectors"),
     ("geometry.boundaryLength", SAME, "", "with or without brackets"),
     ("geometry.height", SAME, "", "with or without brackets"),
     ("geometry.isConcave", SAME, "", "with or without brackets"),

@@ -697,9 +697,21 @@ class Checker:
                 stack += (e.otherwise, e.then, e.cond)
             elif isinstance(e, n.Call):
                 self.call(e)
+                if e.name == "geometry.area" and e.args:  # a face selector, not a value
+                    self.face_selector(e.args[0])
+                    continue
                 stack += reversed(e.args)
             elif isinstance(e, n.Relative):
                 self.error(e.pos, "a relative size ('f) is not allowed here")
+
+    def face_selector(self, arg) -> None:
+        """geometry.area(top): a comp(f) selector written bare."""
+        if not (isinstance(arg, n.Name) and arg.name in COMP_SELECTORS):
+            self.error(
+                arg.pos,
+                "geometry.area() takes a face selector",
+                f"one of {', '.join(COMP_SELECTORS)}, e.g. geometry.area(top)",
+            )
 
     def name(self, e: n.Name, local: set[str], in_rule: bool) -> None:
         name = e.name

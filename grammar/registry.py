@@ -588,10 +588,11 @@ BUILTINS: dict[str, Builtin] = {
         Builtin(
             "geometry.area",
             0,
-            0,
-            "geometry.area()",
-            "the sum of the areas of all the faces of the shape's geometry, in square metres "
-            "(a 10 x 20 m lot: 200; that lot extruded 5 m: 700).",
+            1,
+            "geometry.area(selector)",
+            "the sum of the areas of the faces of the shape's geometry, in square metres (a "
+            "10 x 20 m lot: 200; that lot extruded 5 m: 700): all of them, or those a comp(f) "
+            "selector written bare would take (`geometry.area(top)`: 200).",
         ),
         Builtin(
             "geometry.volume",

@@ -402,6 +402,11 @@ class Compiler:
 
     def call(self, e: n.Call, local: frozenset) -> Compiled:
         module, pos, name = self.module, e.pos, e.name
+        if name == "geometry.area" and e.args:  # a face selector: a bare word, not a value
+            from .geometry.queries import area
+
+            selector = e.args[0].name  # type: ignore[union-attr]  # the checker made sure
+            return lambda ctx: area(ctx.shape, ctx.library, selector)
         args = [self.expr(a, local) for a in e.args]
         if name == "rand":
 

@@ -100,3 +100,14 @@ def test_edges_holes_boundary_concavity_and_planarity():
     assert sizes["truefalse"] == [4.0, 60.0, 0.0]  # the lot: 4 edges, 60 m round, planar
     assert sizes["falsefalse"] == [12.0, 1.0, 1.0]  # the box: 12 edges, closed, no holes
     assert sizes["true"] == [6.0, 1.0, 1.0]  # the L: 6 edges, concave
+
+
+def test_area_of_the_faces_a_selector_takes():
+    # CGA's geometry.area(selector): the faces a comp(f) selector would take
+    sizes = measured(
+        "Lot --> extrude(5) s(geometry.area(top), geometry.area(side), geometry.area(front)) B\n"
+        "terminal B\n"
+    )
+    assert sizes["B"] == pytest.approx([200.0, 300.0, 50.0])
+    with pytest.raises(bgr.BgrError, match="takes a face selector"):
+        bgr.load("version 1\nterminal B\nLot --> s(geometry.area(3), 1, 1) B")

@@ -40,11 +40,37 @@ def _corners(shape, library) -> np.ndarray:
     return verts[faces] if len(faces) else np.zeros((0, 3, 3))
 
 
-def area(shape, library) -> float:
-    """The sum of the areas of all the geometry's faces, in square metres."""
+def area(shape, library, selector: str = "all") -> float:
+    """The sum of the areas of the geometry's faces, in square metres: all of them, or those a
+    comp(f) selector would take (``top``, ``side``, ``front``...: by their normal in the scope)."""
     tri = _corners(shape, library)
     cross = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
-    return float(0.5 * np.linalg.norm(cross, axis=1).sum())
+    sizes = np.linalg.norm(cross, axis=1)
+    if selector != "all" and len(tri):
+        normals = cross / np.maximum(sizes, 1e-300)[:, None]
+        sizes = sizes[_selected(normals, selector)]
+    return float(0.5 * sizes.sum())
+
+
+def _selected(normals: np.ndarray, selector: str) -> np.ndarray:
+    """Which faces (by unit normal in the scope) a comp(f) selector takes."""
+    x, y, z = normals[:, 0], normals[:, 1], normals[:, 2]
+    level = np.abs(y) <= 0.7071
+    sideways = np.abs(x) >= np.abs(z)
+    slope = np.degrees(np.arcsin(np.clip(np.abs(y), 0.0, 1.0)))
+    chosen = {
+        "top": y > 0.7071,
+        "bottom": y < -0.7071,
+        "side": level,
+        "left": level & sideways & (x < 0),
+        "right": level & sideways & (x > 0),
+        "front": level & ~sideways & (z < 0),
+        "back": level & ~sideways & (z > 0),
+        "vertical": slope < 1.0,
+        "horizontal": slope > 89.0,
+        "aslant": (slope >= 1.0) & (slope <= 89.0),
+    }
+    return chosen[selector]
 
 
 def volume(shape, library) -> float:
