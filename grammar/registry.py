@@ -295,7 +295,8 @@ OPERATIONS: dict[str, Op] = {
                 (Param("direction", EXTRUDE_KIND), Param("height", NUMBER)),
             ),
             "Turn a 2D shape into a prism of the given height along its normal (a negative "
-            "height extrudes against it), or along world y with `world.up`. As in CGA, the "
+            "height extrudes against it), or along world y with `world.up`; a solid, each of "
+            "its faces along its own normal. As in CGA, the "
             "new scope's y points along the extrusion, x keeps its direction as far as it "
             "can, and z completes a right-handed frame.",
             "extrude(12)",

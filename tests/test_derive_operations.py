@@ -145,3 +145,16 @@ def test_setback_sets_edges_in_as_cga_does():
     # a distance of 0 sets nothing back: the remainder is the whole shape
     zero = bgr.load("version 1\nterminal S, R\nLot --> setback(0) { all: S | remainder: R }")
     assert list(bgr.derive(zero, lot=(10.0, 10.0)).terminals.label) == ["R"]
+
+
+def test_extrude_of_a_solid_extrudes_each_face_along_its_normal():
+    # CGA extrudes every face of the geometry: a 10 x 20 x 4 box, each face 1 m out
+    import bgr
+
+    result = bgr.derive(
+        bgr.load("version 1\nterminal B\nLot --> extrude(4) extrude(1) B"), lot=(10.0, 20.0)
+    )
+    assert np.allclose(result.mesh.bounds, [[-1, -1, -1], [11, 5, 21]])
+    # six slabs, each the face's area thick 1 m: 2 x 40 + 2 x 80 + 2 x 200
+    assert result.mesh.volume == pytest.approx(640.0)
+    assert result.terminals.size[0] == pytest.approx([12.0, 6.0, 22.0])

@@ -25,6 +25,7 @@ from ..geometry.polygons import (
 )
 from ..shapes import Flat, Prism, Solid, cross, dot, normalise
 from ..terminals import UnitMesh
+from .extrude_faces import extrude_faces
 from .trims import corner_planes
 
 # ---- comp(f) -----------------------------------------------------------------------------------
@@ -500,6 +501,11 @@ def extrude(app, shape, step, args) -> bool:
     given = len(step.args)  # extrude(height) or extrude(direction, height)
     direction = args[0] if given == 2 else "face.normal"
     height = _signed_height(app, step, args[given - 1])
+    if not isinstance(shape.geom, Flat) and direction == "face.normal":
+        # a solid: each face along its own normal, as CGA extrudes every face
+        faces = [(rings, nrm) for rings, nrm, _ in _faces(app, step, shape)]
+        extrude_faces(app, shape, faces, height)
+        return False
     flat, heights = _into_extrusion_frame(app, step, shape, direction, height)
     if heights is None:
         shape.size[1] = abs(height)
