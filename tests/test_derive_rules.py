@@ -115,9 +115,11 @@ def test_division_by_zero_names_the_place():
     assert (e.value.line, e.value.column) == (2, 17) and "division by zero" in e.value.message
 
 
-def test_extruding_a_3d_shape_and_negative_sizes_are_errors():
+def test_tapering_a_3d_shape_and_negative_sizes_are_errors():
+    # extrude() of a solid extrudes each face (test_derive_operations.py); taper() has no
+    # such reading
     with pytest.raises(bgr.BgrError, match="already 3D"):
-        bgr.derive(bgr.load("Lot --> extrude(1) extrude(2)\n"))
+        bgr.derive(bgr.load("Lot --> extrude(1) taper(2, 0.5)\n"))
     # extrude(-1) is CGA's extrusion against the normal (tests/test_scope_frames.py), but a
     # taper is still a height
     with pytest.raises(bgr.BgrError, match="negative height"):

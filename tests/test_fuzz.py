@@ -401,6 +401,8 @@ class _Gen:
                 b = BUILTINS[name]
                 count = self.d(st.integers(b.least, b.most if b.most is not None else b.least + 2))
             toks = [name, "("]
+            if name == "geometry.area" and count:  # its argument is a face selector word
+                return toks + [self.pick(["top", "side", "all"]), ")"]
             for i in range(count):
                 if i:
                     toks.append(",")
