@@ -83,19 +83,7 @@ def prepend_to_start(tr, items: list, steps: list) -> list:
     return items[: at + 1] + [inner] + items[at + 1 :]
 
 
-def _walk(e):
-    stack = [e]
-    while stack:
-        x = stack.pop()
-        yield x
-        if isinstance(x, n.Binary):
-            stack += (x.left, x.right)
-        elif isinstance(x, n.Unary):
-            stack.append(x.operand)
-        elif isinstance(x, n.Ternary):
-            stack += (x.cond, x.then, x.otherwise)
-        elif isinstance(x, n.Call):
-            stack += x.args
+_walk = n.walk  # every node of an expression
 
 
 def _placeholder(e: n.Expr) -> n.Expr:

@@ -61,21 +61,10 @@ def _based(e: n.Expr, tr) -> n.Expr:
     """An expression of the base file, read from the style's grammar: its attrs, consts and
     functions through the import."""
     e = copy.deepcopy(e)
-    stack: list = [e]
     own_values = set(tr.attrs.values()) | set(tr.consts.values())
     own_funcs = {bgr for bgr, _ in tr.funcs.values()}
-    while stack:
-        x = stack.pop()
-        if isinstance(x, n.Name) and x.name in own_values:
+    for x in n.walk(e):
+        own = own_values if isinstance(x, n.Name) else own_funcs if isinstance(x, n.Call) else ()
+        if getattr(x, "name", None) in own:
             x.name = f"{BASE}.{x.name}"
-        elif isinstance(x, n.Call):
-            if x.name in own_funcs:
-                x.name = f"{BASE}.{x.name}"
-            stack += x.args
-        elif isinstance(x, n.Binary):
-            stack += (x.left, x.right)
-        elif isinstance(x, n.Unary):
-            stack.append(x.operand)
-        elif isinstance(x, n.Ternary):
-            stack += (x.cond, x.then, x.otherwise)
     return e

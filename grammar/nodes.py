@@ -359,6 +359,24 @@ class Module:
         return [item for item in self.items if isinstance(item, Rule)]
 
 
+def walk(expr) -> Iterator:
+    """Every node of an expression, itself first, without recursion (chains can be long)."""
+    stack = [expr]
+    while stack:
+        e = stack.pop()
+        yield e
+        if isinstance(e, Binary):
+            stack += (e.left, e.right)
+        elif isinstance(e, Unary):
+            stack.append(e.operand)
+        elif isinstance(e, Ternary):
+            stack += (e.cond, e.then, e.otherwise)
+        elif isinstance(e, Call):
+            stack += e.args
+        elif isinstance(e, (Relative, Keyword)):
+            stack.append(e.expr if isinstance(e, Relative) else e.value)
+
+
 def names_in(expr) -> Iterator[Name]:
     """Every Name inside an expression, without recursion (operator chains can be long)."""
     stack = [expr]
