@@ -96,8 +96,6 @@ DROPPED = {
     "shapeL",
     "shapeU",
     "shapeO",
-    "innerRectangle",
-    "innerRect",
     "splitArea",
     "roofRamp",
     "texture3D",
@@ -126,6 +124,11 @@ def operation(tr: Translator, name: str, args: list, block, meta, rest: list) ->
     if name == "setback" and block is not None and len(args) == 1 and not _is_fcall_block(args[0]):
         body = tr.block(block, "setback")
         return _with_block(tr, "setback", [tr.expr(args[0])], body, meta), True
+    if name in ("innerRectangle", "innerRect") and block is not None:
+        if not args or _word(args[0]) != "scope":
+            tr.warn(meta, "innerRectangle() along the scope's axes only in bgr (scope)")
+        body = tr.block(block, "innerRectangle")
+        return _with_block(tr, "innerRectangle", [n.Name("scope")], body, meta), True
     if name == "setback":
         tr.warn(
             meta,

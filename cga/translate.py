@@ -31,6 +31,7 @@ from ..grammar.registry import (
     BUILTIN_NAMES,
     BUILTINS,
     COMP_SELECTORS,
+    INNER_SELECTORS,
     KEYWORDS,
     OPERATIONS,
     SETBACK_SELECTORS,
@@ -563,6 +564,11 @@ class Translator:
             keys = [w for w in words if w is not None and w not in named]
             named.update(keys)
             return [n.Name(w) for w in keys]
+        if kind == "innerRectangle":
+            if word in INNER_SELECTORS:
+                return [n.Name(word)]
+            self.warn(meta, f"innerRectangle selector '{word or 'this'}' is not in bgr; left out")
+            return []
         if kind == "setback":
             if word in SETBACK_SELECTORS:
                 return [n.Name(word)]

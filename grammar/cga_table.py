@@ -31,7 +31,13 @@ CGA: list[tuple[str, str, str, str]] = [
     ("envelope", NOT_YET, "", ""),
     ("extrude", SAME, "", ""),
     ("i", SAME, "", 'a file path is declared first: `asset x = "x.obj"`, then `i(x)`'),
-    ("innerRectangle", NOT_YET, "", "`innerRect` in older releases"),
+    (
+        "innerRectangle",
+        PARTLY,
+        "",
+        "along the scope's axes (scope), to 1/256 of the scope; edge alignment not yet; "
+        "`innerRect` in older releases",
+    ),
     ("insertAlongUV", NOT_YET, "", ""),
     ("label", SAME, "", ""),
     ("mirror", SAME, "", ""),

@@ -35,6 +35,9 @@ from .registry import (
     FOOTPRINT_KIND,
     FOOTPRINT_KINDS,
     GEOMETRY,
+    INNER_ALIGNMENT,
+    INNER_ALIGNMENTS,
+    INNER_SELECTORS,
     KEYWORDS,
     MANY,
     NORMALIZE_MODE,
@@ -75,6 +78,7 @@ _SYMBOL_KINDS = {
     NORMALIZE_TYPE: NORMALIZE_TYPES,
     UP_AXIS: UP_AXES,
     CLEANUP_KIND: CLEANUP_KINDS,
+    INNER_ALIGNMENT: INNER_ALIGNMENTS,
 }
 _TEXTURE_OPS = ("texture", "normalMap")
 _RESERVED_ALIASES = {"scope", "split", "comp", "stdlib", "geometry"}
@@ -639,9 +643,11 @@ class Checker:
             self.sequence(entry.body, local)
 
     def selector(self, entry: n.Entry, op: Op, local: set[str]) -> None:
-        allowed = {"comp": COMP_SELECTORS, "setback": SETBACK_SELECTORS}.get(
-            op.block or "", OFFSET_SELECTORS
-        )
+        allowed = {
+            "comp": COMP_SELECTORS,
+            "setback": SETBACK_SELECTORS,
+            "innerRectangle": INNER_SELECTORS,
+        }.get(op.block or "", OFFSET_SELECTORS)
         key = entry.key
         if entry.kind != "abs":
             self.error(

@@ -31,6 +31,7 @@ NORMALIZE_MODE = "normalize mode"  # uv | uvUniform | u | v
 NORMALIZE_TYPE = "normalize type"  # separatePerFace | collectiveAllFaces
 UP_AXIS = "up axis"  # yUp | zUp (alignScopeToGeometry)
 CLEANUP_KIND = "components"  # all | faces | edges | vertices (cleanupGeometry)
+INNER_ALIGNMENT = "alignment"  # scope (innerRectangle)
 # a number, or one of a few bare words (alignScopeToGeometry's face and edge)
 FACE_PICK = "face index or selector"  # a number | largest | world.lowest | any
 EDGE_PICK = "edge index or selector"  # a number | longest | world.lowest
@@ -55,6 +56,7 @@ COMP_SELECTORS = (
     "all",
 )
 OFFSET_SELECTORS = ("inside", "border")
+INNER_SELECTORS = ("shape", "remainder")
 SETBACK_SELECTORS = ("front", "back", "left", "right", "top", "bottom", "side", "all", "remainder")
 PROJECTION_AXES_NAMES = tuple(
     f"{frame}.{a}{b}" for frame in ("scope", "world") for a in "xyz" for b in "xyz" if a != b
@@ -63,6 +65,7 @@ NORMALIZE_MODES = ("uv", "uvUniform", "u", "v")
 NORMALIZE_TYPES = ("separatePerFace", "collectiveAllFaces")
 UP_AXES = ("yUp", "zUp")
 CLEANUP_KINDS = ("all", "faces", "edges", "vertices")
+INNER_ALIGNMENTS = ("scope",)
 # CGA's shape attributes set() may change besides a file's attrs: whether trim planes cut
 # (bgr makes vertical ones only, so trim.horizontal changes nothing)
 SHAPE_ATTRIBUTES = ("trim.vertical", "trim.horizontal")
@@ -265,6 +268,15 @@ OPERATIONS: dict[str, Op] = {
             "normal in the scope's quadrants; `side`, `all`) is a piece, `remainder` the rest.",
             "setback(3) { front: Yard | remainder: Building }",
             block="setback",
+        ),
+        Op(
+            "innerRectangle",
+            "components",
+            _sig(Param("alignment", INNER_ALIGNMENT)),
+            "The largest rectangle along the scope's axes inside a 2D shape (`shape`) and the "
+            "rest (`remainder`), as CGA's innerRectangle(scope); exact to 1/256 of the scope.",
+            "innerRectangle(scope) { shape: Building | remainder: Yard }",
+            block="innerRectangle",
         ),
         Op(
             "footprint",

@@ -25,6 +25,7 @@ from bgr.grammar.registry import (
     EXTRUDE_KIND,
     FOOTPRINT_KIND,
     GEOMETRY,
+    INNER_ALIGNMENT,
     NORMALIZE_MODE,
     NORMALIZE_TYPE,
     NUMBER,
@@ -74,6 +75,7 @@ SYMBOL_KINDS = {
     NORMALIZE_TYPE,
     UP_AXIS,
     CLEANUP_KIND,
+    INNER_ALIGNMENT,
 }
 _NUMERIC_KINDS = {
     NUMBER,

@@ -158,3 +158,23 @@ def test_extrude_of_a_solid_extrudes_each_face_along_its_normal():
     # six slabs, each the face's area thick 1 m: 2 x 40 + 2 x 80 + 2 x 200
     assert result.mesh.volume == pytest.approx(640.0)
     assert result.terminals.size[0] == pytest.approx([12.0, 6.0, 22.0])
+
+
+def test_inner_rectangle_is_the_largest_rectangle_along_the_scope():
+    # CGA's innerRectangle(scope) { shape: A | remainder: B }: an L's largest inner rectangle is
+    # its longer bar; a rectangle is its own
+    import bgr
+
+    text = (
+        "version 1\nterminal In, Out\n"
+        "Lot --> FOOT innerRectangle(scope) { shape: In | remainder: Out }"
+    )
+    ell = bgr.derive(bgr.load(text.replace("FOOT", "footprint(L, 0.4, 0.5)")), lot=(20.0, 15.0))
+    pieces = {
+        label: [round(float(v), 6) for v in ell.terminals.size[k]]
+        for k, label in enumerate(ell.terminals.label)
+    }
+    assert pieces == {"In": [20.0, 0.0, 7.5], "Out": [8.0, 0.0, 7.5]}
+    assert ell.mesh.area == pytest.approx(20 * 7.5 + 8 * 7.5)
+    box = bgr.derive(bgr.load(text.replace("FOOT ", "")), lot=(20.0, 15.0))
+    assert list(box.terminals.label) == ["In"]

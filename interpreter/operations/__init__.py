@@ -37,6 +37,7 @@ IMPLEMENTATIONS = {
     "comp": components.comp,
     "offset": components.offset,
     "setback": setbacks.setback,
+    "innerRectangle": setbacks.inner_rectangle,
     "extrude": components.extrude,
     "footprint": components.footprint,
     "polygon": components.polygon,

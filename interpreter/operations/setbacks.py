@@ -72,3 +72,22 @@ def _piece(app, shape, step, entry, metric_polys, p: int, q: int, k: int) -> Non
     piece.geom = Flat(k, RECT if is_unit_square(unit) else unit)
     app.engine.count_shape(app.module, entry.pos)
     app.piece(piece, entry.body)
+
+
+def inner_rectangle(app, shape, step, args) -> bool:
+    """innerRectangle(scope) { shape: A | remainder: B }: the largest rectangle along the scope's
+    axes inside a 2D shape, and the rest (interpreter/geometry/inner_rectangle.py)."""
+    from ..geometry.inner_rectangle import inner_rectangle as largest
+
+    geom = shape.geom
+    if not isinstance(geom, Flat):
+        raise runtime_error(
+            app.module, step.pos, "innerRectangle() needs a 2D shape", "use it on a lot or a face"
+        )
+    p, q = PLANE_AXES[geom.k]
+    polys = [(UNIT_SQUARE, ())] if geom.polys == RECT else geom.polys
+    rect, rest = largest(polys, shape.size[p], shape.size[q])
+    for entry in step.block.entries:
+        part = rect if entry.key.name == "shape" else rest
+        _piece(app, shape, step, entry, part, p, q, geom.k)
+    return True
