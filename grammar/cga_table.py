@@ -35,8 +35,7 @@ CGA: list[tuple[str, str, str, str]] = [
         "innerRectangle",
         PARTLY,
         "",
-        "along the scope's axes (scope), to 1/256 of the scope; edge alignment not yet; "
-        "`innerRect` in older releases",
+        "along the scope's axes (scope); edge alignment not yet; `innerRect` in older releases",
     ),
     ("insertAlongUV", NOT_YET, "", ""),
     ("label", SAME, "", ""),

@@ -274,7 +274,8 @@ OPERATIONS: dict[str, Op] = {
             "components",
             _sig(Param("alignment", INNER_ALIGNMENT)),
             "The largest rectangle along the scope's axes inside a 2D shape (`shape`) and the "
-            "rest (`remainder`), as CGA's innerRectangle(scope); exact to 1/256 of the scope.",
+            "rest (`remainder`), as CGA's innerRectangle(scope): exact for outlines whose sides "
+            "run along the scope, to 1/64 of it for others.",
             "innerRectangle(scope) { shape: Building | remainder: Yard }",
             block="innerRectangle",
         ),
