@@ -245,14 +245,17 @@ def split(tr: Translator, args: list, block: Tree, meta) -> list:
 
 def comp(tr: Translator, args: list, block: Tree, meta) -> list:
     kind = _word(args[0]) if args else None
-    if kind != "f":
+    if kind not in ("f", "e", "v"):
         tr.warn(
             meta,
-            f"comp({kind}) is not in bgr yet (faces only); its shape is dropped (NIL)",
+            f"comp({kind}) is not in bgr yet (faces, edges and vertices only); its shape is "
+            "dropped (NIL)",
             "the parts it would make are missing from the translation",
         )
         return [n.Nil(pos=pos(meta))]
-    return _with_block(tr, "comp", [n.Name("f")], tr.block(block, "comp"), meta)
+    if len(args) > 1:
+        tr.warn(meta, "comp()'s scope alignment (noAlign) is not in bgr; it is left out")
+    return _with_block(tr, "comp", [n.Name(kind)], tr.block(block, f"comp:{kind}"), meta)
 
 
 def _is_fcall_block(t) -> bool:

@@ -30,11 +30,14 @@ from ..grammar.errors import Diagnostic, source_line
 from ..grammar.registry import (
     BUILTIN_NAMES,
     BUILTINS,
+    COMP_INDEX_CALLS,
     COMP_SELECTORS,
+    EDGE_SELECTORS,
     INNER_SELECTORS,
     KEYWORDS,
     OPERATIONS,
     SETBACK_SELECTORS,
+    VERTEX_SELECTORS,
 )
 from . import media
 from . import operations as ops
@@ -574,12 +577,18 @@ class Translator:
                 return [n.Name(word)]
             self.warn(meta, f"setback selector '{word or 'this'}' is not in bgr yet; left out")
             return []
-        if word in COMP_SELECTORS:
+        comp_kind = kind.partition(":")[2] or "f"  # "comp:e": the block of a comp(e)
+        allowed = {"e": EDGE_SELECTORS, "v": VERTEX_SELECTORS}.get(comp_kind, COMP_SELECTORS)
+        if word in allowed:
             return [n.Name(word)]
         if isinstance(t, Tree) and t.data == "number":
-            return [n.Call("face", [n.Number(float(str(t.children[0])))])]
+            index = n.Number(float(str(t.children[0])))
+            return [n.Call(COMP_INDEX_CALLS[comp_kind], [index])]
+        parts = {"f": "faces", "e": "edges", "v": "vertices"}[comp_kind]
         self.warn(
-            meta, f"comp(f) selector '{word or 'this'}' is not in bgr yet; its faces are left out"
+            meta,
+            f"comp({comp_kind}) selector '{word or 'this'}' is not in bgr yet; its {parts} are "
+            "left out",
         )
         return []
 

@@ -24,7 +24,13 @@ CGA: list[tuple[str, str, str, str]] = [
     ("center", SAME, "", ""),
     ("cleanupGeometry", SAME, "", ""),
     ("color", SAME, "", ""),
-    ("comp", PARTLY, "", "faces (`comp(f)`) with their selectors; edges and vertices not yet"),
+    (
+        "comp",
+        PARTLY,
+        "",
+        "faces, edges and vertices (`f`, `e`, `v`) with their selectors, roof edges included; "
+        "`fe`, `fv`, `g`, `m`, `h`, the `=` operator, street and object selectors not yet",
+    ),
     ("convexify", PARTLY, "", "2D shapes; a solid's faces not yet"),
     ("deleteHoles", NOT_YET, "", ""),
     ("deleteUV", SAME, "", ""),

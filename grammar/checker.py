@@ -27,9 +27,11 @@ from .registry import (
     CLEANUP_KIND,
     CLEANUP_KINDS,
     COLOR,
+    COMP_INDEX_CALLS,
     COMP_KIND,
     COMP_KINDS,
     COMP_SELECTORS,
+    EDGE_SELECTORS,
     EXTRUDE_KIND,
     EXTRUDE_KINDS,
     FOOTPRINT_KIND,
@@ -60,6 +62,7 @@ from .registry import (
     TEX_SIZE,
     UP_AXES,
     UP_AXIS,
+    VERTEX_SELECTORS,
     Op,
 )
 from .site import problems as site_problems
@@ -134,6 +137,7 @@ class Checker:
         self.diagnostics: list[Diagnostic] = []
         # aliases whose import failed: names under them are not reported a second time
         self.broken_aliases = set(k for k, bad in (import_errors or {}).items() if bad)
+        self.comp_kind = "f"  # the kind of the comp whose block is being checked
 
     # ---- reporting ------------------------------------------------------------------------
     def error(
@@ -469,7 +473,12 @@ class Checker:
                 f"only split blocks repeat; '{op.name}' {{ ... }} cannot take a '*'",
                 "remove the '*'",
             )
+        outer = self.comp_kind
+        if op.block == "comp":
+            kind = step.args[0] if step.args else None
+            self.comp_kind = kind.name if isinstance(kind, n.Name) else "f"
         self.block_entries(step.block.entries, op, local, in_group=False)
+        self.comp_kind = outer
 
     def pick_signature(self, op: Op, step: n.Operation):
         count = len(step.args)
@@ -643,8 +652,9 @@ class Checker:
             self.sequence(entry.body, local)
 
     def selector(self, entry: n.Entry, op: Op, local: set[str]) -> None:
+        comp_selectors = {"e": EDGE_SELECTORS, "v": VERTEX_SELECTORS}
         allowed = {
-            "comp": COMP_SELECTORS,
+            "comp": comp_selectors.get(self.comp_kind, COMP_SELECTORS),
             "setback": SETBACK_SELECTORS,
             "innerRectangle": INNER_SELECTORS,
         }.get(op.block or "", OFFSET_SELECTORS)
@@ -658,14 +668,15 @@ class Checker:
             return
         if isinstance(key, n.Name) and key.name in allowed:
             return
-        if op.block == "comp" and isinstance(key, n.Call) and key.name == "face":
+        index_call = COMP_INDEX_CALLS.get(self.comp_kind, "face")
+        if op.block == "comp" and isinstance(key, n.Call) and key.name == index_call:
             if len(key.args) != 1:
-                self.error(key.pos, "face() takes one argument, the face index")
+                self.error(key.pos, f"{index_call}() takes one argument, the {index_call} index")
             else:
                 self.expr(key.args[0], local, in_rule=True)
             return
         word = key.name if isinstance(key, (n.Name, n.Call)) else None
-        extra = ", face(i)" if op.block == "comp" else ""
+        extra = f", {index_call}(i)" if op.block == "comp" else ""
         hint = suggest(word, allowed) if word else None
         self.error(
             key.pos,

@@ -20,7 +20,7 @@ VALUE = "value"  # a number, a string or true/false (report's value)
 ATTR_NAME = "attr name"  # a bare word naming an attr of the file (set's first argument)
 AXIS = "axis"  # x | y | z
 AXES = "axes"  # a non-empty combination of x, y, z: xz, xyz ...
-COMP_KIND = "comp kind"  # f (faces)
+COMP_KIND = "comp kind"  # f (faces) | e (edges) | v (vertices)
 ROOF_KIND = "roof kind"  # flat | gable | ...
 FOOTPRINT_KIND = "footprint kind"  # rect | L | U | T | cross | circle
 EXTRUDE_KIND = "extrusion direction"  # face.normal | world.up
@@ -37,7 +37,7 @@ FACE_PICK = "face index or selector"  # a number | largest | world.lowest | any
 EDGE_PICK = "edge index or selector"  # a number | longest | world.lowest
 
 AXIS_NAMES = ("x", "y", "z")
-COMP_KINDS = ("f",)
+COMP_KINDS = ("f", "e", "v")
 ROOF_KINDS = ("flat", "gable", "hip", "pyramid", "shed", "mansard", "gambrel")
 FOOTPRINT_KINDS = ("rect", "L", "U", "T", "cross", "circle")
 EXTRUDE_KINDS = ("face.normal", "world.up")
@@ -53,8 +53,14 @@ COMP_SELECTORS = (
     "vertical",
     "horizontal",
     "aslant",
+    "nutant",
     "all",
 )
+# edges also take CGA's roof selectors and border/inside; an index selector is face(i),
+# edge(i) or vertex(i) by the comp's kind
+EDGE_SELECTORS = (*COMP_SELECTORS, "border", "inside", "eave", "ridge", "hip", "valley")
+VERTEX_SELECTORS = (*COMP_SELECTORS, "border", "inside")
+COMP_INDEX_CALLS = {"f": "face", "e": "edge", "v": "vertex"}
 OFFSET_SELECTORS = ("inside", "border")
 INNER_SELECTORS = ("shape", "remainder")
 SETBACK_SELECTORS = ("front", "back", "left", "right", "top", "bottom", "side", "all", "remainder")
@@ -245,8 +251,12 @@ OPERATIONS: dict[str, Op] = {
             "comp",
             "components",
             _sig(Param("kind", COMP_KIND)),
-            "Split a 3D shape into its faces (`f`), each a 2D shape with x along its bottom edge, "
-            "y up and z out.",
+            "Split a shape into its faces (`f`), each a 2D shape with x along its bottom edge, "
+            "y up and z out; into its edges (`e`), each a bare shape of zero height and depth "
+            "with x along the edge and y the mean of its faces' normals (`eave`, `ridge`, `hip`, "
+            "`valley`, `border`, `inside` select them too); or into its vertices (`v`), each a "
+            "bare point with y its faces' mean normal.  Bare shapes make no terminals: give "
+            "them a size and an `i()`.",
             "comp(f) { top: Roof | side: Facade }",
             block="comp",
         ),

@@ -13,6 +13,8 @@ import math
 import os
 from dataclasses import replace
 
+import numpy as np
+
 from bgr.grammar import nodes as n
 from bgr.grammar.checker import bind_problem
 from bgr.grammar.errors import BgrError, Diagnostic, Warnings, suggest
@@ -166,6 +168,7 @@ class Engine:
         self._bindings: dict = {}
         self._exprs: dict[int, object] = {}
         self._flat_ids: dict[tuple, int] = {}
+        self._bare_ids: set[int] = set()  # the meshes of bare shapes (comp(e), comp(v))
         self.split_cache: dict = {}  # (block id, sizes, length) -> placed pieces
         self.constant_sizes: dict[int, tuple | None] = {}  # id(entries) -> literal sizes
         # id(operation node) -> its signature (the grammar outlives us)
@@ -391,6 +394,9 @@ class Engine:
     def emit(self, shape: Shape, label: str, rule: str, module, pos: n.Pos) -> None:
         """Append a terminal row; ``module`` and ``pos`` (where it was made) locate a budget
         error."""
+        geom = shape.geom
+        if isinstance(geom, Solid) and geom.mesh in self._bare_ids:
+            return  # an edge or a vertex left as it is: nothing to show, as in CityEngine
         t = self.table
         t.label.append(shape.label or label)
         t.rule.append(rule)
@@ -444,6 +450,16 @@ class Engine:
                     _UNIT_MESHES.clear()
                 _UNIT_MESHES[key] = built
         found = self._flat_ids[key] = self.table.library.add(*built)
+        return found
+
+    def bare_id(self, name: str) -> int:
+        """The empty unit mesh of comp(e)'s edges and comp(v)'s vertices (``name``)."""
+        key = ("bare", name)
+        found = self._flat_ids.get(key)
+        if found is None:
+            empty = UnitMesh(name, np.zeros((0, 3)), np.zeros((0, 3), dtype=np.int32))
+            found = self._flat_ids[key] = self.table.library.add(empty)
+            self._bare_ids.add(found)
         return found
 
     def primitive_id(self, name: str) -> int:

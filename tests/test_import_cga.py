@@ -134,18 +134,18 @@ def test_what_bgr_lacks_is_reported_at_its_place_and_left_out(tmp_path):
         """Lot --> setPivot(xyz, 0)
     extrude(10)
     comp(f) { front: Front | side: Side }
-Front --> comp(e) { all: Edge }
+Front --> comp(h) { all: Edge }
 Side --> envelope(world.up, 1, 1, 45, 1, 45) color(case inside(all): 1 else: 0, 0, 0)
 Edge --> color(1, 0, 0)
 """,
     )
     found = {(w.line, w.column): w.message for w in result.warnings}
     assert "setPivot" in found[(1, 9)]
-    assert "comp(e)" in found[(4, 11)]
+    assert "comp(h)" in found[(4, 11)]
     assert "envelope" in found[(5, 10)]
     assert any(line == 5 and "inside" in m for (line, _), m in found.items())
     labels = _labels(_derive(out))
-    assert "Edge" not in labels and labels["Side"] == 3  # comp(e) stood as NIL
+    assert "Edge" not in labels and labels["Side"] == 3  # comp(h) stood as NIL
 
 
 def test_assets_beside_the_file_and_missing_ones(tmp_path):

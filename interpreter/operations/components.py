@@ -7,8 +7,6 @@ import math
 import numpy as np
 import shapely
 
-from bgr.grammar import nodes as n
-
 from ..expressions import runtime_error
 from ..geometry.frames import WORLD_UP, extrusion_axes, planar_faces, reframe_flat
 from ..geometry.meshes import PLANE_AXES
@@ -26,12 +24,13 @@ from ..geometry.polygons import (
 from ..shapes import Flat, Prism, Solid, cross, dot, normalise
 from ..terminals import UnitMesh
 from .extrude_faces import extrude_faces
+from .selection import check_budget, select, words
 from .trims import corner_planes
 
 # ---- comp(f) -----------------------------------------------------------------------------------
 
 
-def _faces(app, step, shape):
+def faces_of(app, step, shape):
     """Faces of a shape as (points in scope-local metres, outward normal in scope coordinates)."""
     geom = shape.geom
     if isinstance(geom, Solid) and geom.name == "cube":
@@ -151,17 +150,6 @@ def _left_right(rings, nrm, turns) -> tuple[float, float]:
 # solids whose planar faces comp(f) takes apart: a roof's slopes and gable ends, a taper's caps
 # and sides, an extrusion along world y (assets and the round primitives are left whole)
 _MESH_FACES = ("roof", "taper", "extrusion")
-_SIN_1_DEGREE = math.sin(math.radians(1.0))
-
-
-def _classify(nrm) -> str:
-    """top, bottom, front, back, left or right, by the outward normal in the shape's scope."""
-    x, y, z = nrm
-    if abs(y) > 0.7071:
-        return "top" if y > 0 else "bottom"
-    if abs(x) >= abs(z):
-        return "right" if x > 0 else "left"
-    return "back" if z > 0 else "front"
 
 
 def _face_shape(shape, rings, nrm):
@@ -195,63 +183,17 @@ def _face_shape(shape, rings, nrm):
     return face
 
 
-def _shown(value) -> str:
-    return f'the string "{value}"' if isinstance(value, str) else repr(value)
-
-
-def _slant(nrm) -> str:
-    """CGA's vertical, horizontal and aslant: the face's normal within 1 degree of the scope's
-    horizontal plane, within 1 degree of its y axis, or neither."""
-    y = abs(nrm[1])
-    if y <= _SIN_1_DEGREE:
-        return "vertical"
-    return "horizontal" if y >= math.cos(math.radians(1.0)) else "aslant"
-
-
-def _matches(app, key, kind: str, index: int, slant: str) -> bool:
-    if isinstance(key, n.Call):  # face(i)
-        i = app.value(key.args[0])
-        # a whole number only: face(0.5) is no face (int() would make it face 0)
-        whole = isinstance(i, int) or (isinstance(i, float) and i.is_integer())
-        if isinstance(i, bool) or not whole:
-            raise runtime_error(
-                app.module, key.pos, f"face() needs a whole number, got {_shown(i)}"
-            )
-        return i == index
-    name = key.name
-    if name in ("all", kind, slant):
-        return True
-    return name == "side" and kind not in ("top", "bottom")
-
-
 _BOXES = ("cube", "extrusion")  # solids whose walls get trim planes, as a prism's do
 
 
-def comp(app, shape, step, args) -> bool:
-    faces = _faces(app, step, shape)
-    left = app.engine.max_shapes - app.engine.shapes
-    if len(faces) > left:  # counted before any face is made, as a split's pieces are
-        raise runtime_error(
-            app.module,
-            step.pos,
-            f"this comp would make {len(faces):,} faces, more than {left:,} shapes (what the "
-            "shape budget has left)",
-            "simplify the footprint, or raise the budget with --max-shapes",
-        )
-    kinds = [_classify(nrm) for _, nrm, _ in faces]
-    slants = [_slant(nrm) for _, nrm, _ in faces]
-    taken = [False] * len(faces)
+def comp_faces(app, shape, step) -> bool:
+    """comp(f): each face a 2D shape of its own (LANGUAGE.md section 7)."""
+    faces = faces_of(app, step, shape)
+    check_budget(app, step, len(faces), "faces")
+    answers = [words(nrm) for _, nrm, _ in faces]
     geom = shape.geom
     walls = isinstance(geom, Prism) or (isinstance(geom, Solid) and geom.name in _BOXES)
-    for entry in step.block.entries:
-        selector = entry.key.name if isinstance(entry.key, n.Name) else "face"
-        chosen = [
-            i
-            for i in range(len(faces))
-            if not taken[i] and _matches(app, entry.key, kinds[i], i, slants[i])
-        ]
-        for i in chosen:
-            taken[i] = True
+    for entry, selector, chosen in select(app, step, answers):
         for j, i in enumerate(chosen):
             rings, nrm, turns = faces[i]
             face = _face_shape(shape, rings, nrm)
@@ -294,7 +236,7 @@ def _pieces(polys, su: float, sv: float, distance: float) -> dict:
 def offset(app, shape, step, args) -> bool:
     if not isinstance(shape.geom, Flat):
         # a solid: each of its faces is offset in its own plane, as CGA offsets every face
-        faces = _faces(app, step, shape)
+        faces = faces_of(app, step, shape)
         for rings, nrm, _ in faces:
             _offset_flat(app, _face_shape(shape, rings, nrm), step, args)
         return True
@@ -503,7 +445,7 @@ def extrude(app, shape, step, args) -> bool:
     height = _signed_height(app, step, args[given - 1])
     if not isinstance(shape.geom, Flat) and direction == "face.normal":
         # a solid: each face along its own normal, as CGA extrudes every face
-        faces = [(rings, nrm) for rings, nrm, _ in _faces(app, step, shape)]
+        faces = [(rings, nrm) for rings, nrm, _ in faces_of(app, step, shape)]
         extrude_faces(app, shape, faces, height)
         return False
     flat, heights = _into_extrusion_frame(app, step, shape, direction, height)
