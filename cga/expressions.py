@@ -17,7 +17,7 @@ from typing import Protocol
 from lark import Token, Tree
 
 from ..grammar import nodes as n
-from ..grammar.registry import BUILTIN_NAMES, BUILTINS, COMP_SELECTORS
+from ..grammar.registry import BUILTIN_NAMES, BUILTINS, WORD_ARGUMENTS
 
 # CGA's scope and context names with a bgr twin of another name (the rest keep theirs)
 NAMES = {
@@ -171,11 +171,15 @@ class Expressions:
 
     def _fcall(self, t: Tree) -> n.Expr:
         name = dotted(t.children[0])
-        if name == "geometry.area" and t.children[1] is not None:
+        if name in WORD_ARGUMENTS and t.children[1] is not None:
             arg = t.children[1].children[0]
             word = dotted(arg.children[0]) if isinstance(arg, Tree) and arg.data == "name" else None
-            if word in COMP_SELECTORS:
-                return n.Call(name, [n.Name(word)])
+            if word in WORD_ARGUMENTS[name]:  # an occlusion query's label comes after
+                rest = [self.arg(a) for a in _args(t.children[1])[1:]]
+                return n.Call(name, [n.Name(word), *rest])
+            if name == "geometry.angle":
+                self.ctx.warn(t.meta, f"geometry.angle({word or ''}) is not in bgr; 0 stands in")
+                return n.Number(0.0)
             self.ctx.warn(
                 t.meta,
                 "geometry.area() of this selector is not in bgr yet; the "

@@ -41,6 +41,8 @@ SAME = {
     "r",
     "center",
     "extrude",
+    "envelope",
+    "trim",
     "taper",
     "color",
     "label",
@@ -78,9 +80,7 @@ PRIMITIVES = {
 BUILTIN_ASSETS = {"cube": "cube", "cylinder": "cylinder", "sphere": "sphere", "quad": "quad"}
 # operations that change the shape in a way bgr cannot yet: dropped, the shape goes on as it was
 DROPPED = {
-    "envelope",
     "mirrorScope",
-    "trim",
     "setPivot",
     "setNormals",
     "softenNormals",
@@ -197,9 +197,16 @@ def same(tr: Translator, name: str, args: list, meta) -> list:
         where = pos(meta)
         return [n.Operation("t", half, pos=where), *turn, n.Operation("t", back, pos=where)]
     word = _word(args[0]) if args else None
-    if name == "extrude" and word is not None and word.startswith(("world.", "face.", "vertex.")):
+    if name == "envelope" and word == "normal":  # CGA's word for the face's normal
+        out.append(n.Name("face.normal"))
+        args = args[1:]
+    elif (
+        name in ("extrude", "envelope")
+        and word is not None
+        and word.startswith(("world.", "face.", "vertex."))
+    ):
         if word not in ("world.up", "face.normal"):
-            tr.warn(meta, f"extrude({word}, ...) is extruded along world.up")
+            tr.warn(meta, f"{name}({word}, ...) is erected along world.up")
         out.append(n.Name("world.up" if word != "face.normal" else "face.normal"))
         args = args[1:]
     if len(args) + len(out) > most:

@@ -34,7 +34,12 @@ CGA: list[tuple[str, str, str, str]] = [
     ("convexify", PARTLY, "", "2D shapes; a solid's faces not yet"),
     ("deleteHoles", NOT_YET, "", ""),
     ("deleteUV", SAME, "", ""),
-    ("envelope", NOT_YET, "", ""),
+    (
+        "envelope",
+        PARTLY,
+        "",
+        "the four forms by side; per-edge arrays and street edges (`streetWidth`) not yet",
+    ),
     ("extrude", SAME, "", ""),
     ("i", SAME, "", 'a file path is declared first: `asset x = "x.obj"`, then `i(x)`'),
     (
@@ -105,8 +110,8 @@ CGA: list[tuple[str, str, str, str]] = [
         "trim",
         PARTLY,
         "set(trim.vertical, true)",
-        "vertical trim planes from comp(f) cut what i() inserts, once turned on (import-cga "
-        "does); the trim() operation and horizontal planes not yet",
+        "vertical trim planes from comp(f) cut what i() inserts and the trim() operation cuts, "
+        "once turned on (import-cga does); horizontal planes not yet",
     ),
     # ---- functions -------------------------------------------------------------------------
     ("abs", SAME, "", ""),
@@ -123,7 +128,7 @@ CGA: list[tuple[str, str, str, str]] = [
     ("find", SAME, "", ""),
     ("float", SAME, "", ""),
     ("floor", SAME, "", ""),
-    ("geometry.angle", NOT_YET, "", ""),
+    ("geometry.angle", SAME, "", "maxSlope, azimuth and zenith; north is -z, as in CityEngine"),
     ("geometry.area", SAME, "", "with or without brackets; the comp(f) face selectors"),
     ("geometry.boundaryLength", SAME, "", "with or without brackets"),
     ("geometry.height", SAME, "", "with or without brackets"),
@@ -135,7 +140,7 @@ CGA: list[tuple[str, str, str, str]] = [
     ("geometry.nHoles", SAME, "", "with or without brackets"),
     ("geometry.nVertices", SAME, "", "with or without brackets"),
     ("geometry.volume", SAME, "", "with or without brackets"),
-    ("inside", NOT_YET, "", "occlusion queries"),
+    ("inside", PARTLY, "", "occlusion queries within the lot (intra, all); inter answers false"),
     ("isinf", SAME, "", ""),
     ("isnan", SAME, "", ""),
     ("len", SAME, "", ""),
@@ -143,7 +148,7 @@ CGA: list[tuple[str, str, str, str]] = [
     ("log10", SAME, "", ""),
     ("max", SAME, "", ""),
     ("min", SAME, "", ""),
-    ("overlaps", NOT_YET, "", "occlusion queries"),
+    ("overlaps", PARTLY, "", "occlusion queries within the lot (intra, all); inter answers false"),
     ("p", SAME, "", "or a stochastic rule: `30%: A | else: B`"),
     ("pow", DIFFERENT, "a ** b", ""),
     ("rand", SAME, "", ""),
@@ -154,7 +159,7 @@ CGA: list[tuple[str, str, str, str]] = [
     ("str", SAME, "", "and `+` joining a string with a number"),
     ("substring", SAME, "", ""),
     ("tan", SAME, "", ""),
-    ("touches", NOT_YET, "", "occlusion queries"),
+    ("touches", PARTLY, "", "occlusion queries within the lot (intra, all); inter answers false"),
     # ---- other words -----------------------------------------------------------------------
     (
         "@Range, @Enum, @Group, ... (annotations)",

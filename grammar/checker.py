@@ -48,6 +48,7 @@ from .registry import (
     NORMALIZE_TYPES,
     NUMBER,
     NUMBER_OR_WORD,
+    OCCLUSION,
     OFFSET_SELECTORS,
     OPERATIONS,
     PRIMITIVES,
@@ -63,6 +64,7 @@ from .registry import (
     UP_AXES,
     UP_AXIS,
     VERTEX_SELECTORS,
+    WORD_ARGUMENTS,
     Op,
 )
 from .site import problems as site_problems
@@ -118,6 +120,7 @@ class Grammar:
     warnings: list[Diagnostic] = field(default_factory=list)  # bgr.load: its own and its imports'
     barren: dict[str, str] = field(default_factory=dict)  # rule -> its cycle (.productive)
     settable: set[str] = field(default_factory=set)  # attrs a set() of its rules changes
+    occlusion: bool = False  # whether it asks inside(), overlaps() or touches() (occlusion.py)
 
     def lookup_module(self, dotted: str) -> tuple[Grammar, str]:
         """Split ``alias.Name`` into (module, member); a plain name is this module's own."""
@@ -714,20 +717,25 @@ class Checker:
                 stack += (e.otherwise, e.then, e.cond)
             elif isinstance(e, n.Call):
                 self.call(e)
-                if e.name == "geometry.area" and e.args:  # a face selector, not a value
-                    self.face_selector(e.args[0])
+                if e.name in OCCLUSION:
+                    self.g.occlusion = True
+                if e.name in WORD_ARGUMENTS and e.args:  # a bare word, not a value
+                    self.word_argument(e.name, e.args[0])
+                    stack += reversed(e.args[1:])  # an occlusion query's label: a value
                     continue
                 stack += reversed(e.args)
             elif isinstance(e, n.Relative):
                 self.error(e.pos, "a relative size ('f) is not allowed here")
 
-    def face_selector(self, arg) -> None:
-        """geometry.area(top): a comp(f) selector written bare."""
-        if not (isinstance(arg, n.Name) and arg.name in COMP_SELECTORS):
+    def word_argument(self, name: str, arg) -> None:
+        """geometry.area(top), geometry.angle(maxSlope): a word from a fixed set, written bare."""
+        words = WORD_ARGUMENTS[name]
+        if not (isinstance(arg, n.Name) and arg.name in words):
+            what = "a face selector" if name == "geometry.area" else "one of its words"
             self.error(
                 arg.pos,
-                "geometry.area() takes a face selector",
-                f"one of {', '.join(COMP_SELECTORS)}, e.g. geometry.area(top)",
+                f"{name}() takes {what}",
+                f"one of {', '.join(words)}, e.g. {name}({words[0]})",
             )
 
     def name(self, e: n.Name, local: set[str], in_rule: bool) -> None:

@@ -80,6 +80,9 @@ NUMBER_OR_WORD = {
     FACE_PICK: ("largest", "world.lowest", "any"),
     EDGE_PICK: ("longest", "world.lowest"),
 }
+ANGLE_KINDS = ("maxSlope", "azimuth", "zenith")  # geometry.angle's bare word
+OCCLUSION_TARGETS = ("all", "intra", "inter")  # inside/overlaps/touches' bare word
+OCCLUSION = ("inside", "overlaps", "touches")
 UV_SETS = 10  # uv-sets 0..9, as CGA's texture layers (material.colormap is 0, normalmap 5)
 
 REQUIRED = object()
@@ -325,6 +328,32 @@ OPERATIONS: dict[str, Op] = {
             "extrude(12)",
         ),
         Op(
+            "envelope",
+            "components",
+            tuple(
+                (
+                    Param("direction", EXTRUDE_KIND),
+                    Param("maxHeight", NUMBER),
+                    *(
+                        Param(f"{side}{what}", NUMBER)
+                        for side in sides
+                        for what in ("BaseHeight", "Angle")
+                    ),
+                )
+                for sides in (
+                    ("front",),
+                    ("front", "back"),
+                    ("front", "back", "side"),
+                    ("front", "back", "right", "left"),
+                )
+            ),
+            "CGA's building envelope: the 2D shape erected to `maxHeight`, each side of its "
+            "outline (front, back, right, left by its outward normal, as setback's; `side` both "
+            "of the last two; missing ones as the one before) cut by a plane through the edge at "
+            "its base height, rising inward at its angle from the horizontal (90: a plain wall).",
+            "envelope(world.up, 30, 12, 45, 8, 60)",
+        ),
+        Op(
             "taper",
             "components",
             _sig(Param("height", NUMBER), Param("ratio", NUMBER)),
@@ -353,6 +382,15 @@ OPERATIONS: dict[str, Op] = {
             "to "
             "the scope.",
             "i(cube)",
+        ),
+        Op(
+            "trim",
+            "inserts",
+            _sig(),
+            "Cut the shape's geometry by its trim planes now, as CGA's trim() (`i()` cuts what "
+            "it inserts by itself); nothing happens while trimming is off or no plane crosses "
+            "the shape, and a shape wholly cut away is gone.",
+            "trim()",
         ),
         # -- appearance --------------------------------------------------------------------
         Op(
@@ -619,6 +657,34 @@ BUILTINS: dict[str, Builtin] = {
             "selector written bare would take (`geometry.area(top)`: 200).",
         ),
         Builtin(
+            "geometry.angle",
+            1,
+            1,
+            "geometry.angle(kind)",
+            "an angle of the shape's geometry in degrees, as CGA's: `maxSlope` the steepest of "
+            "its faces against the world's horizontal plane (a lot: 0, a wall: 90), `zenith` "
+            "90 minus that, `azimuth` the compass direction that steepest face looks to, "
+            "clockwise from north (-z; east, +x, is 90).",
+        ),
+        *(
+            Builtin(
+                name,
+                0,
+                2,
+                f"{name}(target, label)",
+                f"CGA's occlusion query: true when the shape's geometry {what} the closed "
+                "geometry of another shape of the same lot (`intra` or `all`, the default; "
+                "`inter`, other lots, is not taken: false), or only of shapes that "
+                "`label(label)` named; tested against the lot derived once with every query "
+                "false (see language.md).",
+            )
+            for name, what in (
+                ("inside", "lies wholly inside or on"),
+                ("overlaps", "lies partly inside (or holds part of)"),
+                ("touches", "overlaps or lies against"),
+            )
+        ),
+        Builtin(
             "geometry.volume",
             0,
             0,
@@ -682,6 +748,13 @@ BUILTINS: dict[str, Builtin] = {
 }
 
 # Names the interpreter provides while deriving a shape (LANGUAGE.md section 8).
+# functions whose argument is a bare word from a fixed set, not a value
+WORD_ARGUMENTS: dict[str, tuple[str, ...]] = {
+    "geometry.area": COMP_SELECTORS,
+    "geometry.angle": ANGLE_KINDS,
+    **{name: OCCLUSION_TARGETS for name in OCCLUSION},
+}
+
 BUILTIN_NAMES: dict[str, str] = {
     "scope.sx": "scope size along x",
     "scope.sy": "scope size along y",

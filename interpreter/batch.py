@@ -40,6 +40,7 @@ from bgr.grammar.parser import no_gc
 from .engine import Engine
 from .limits import default_max_memory, memory_in_use
 from .lots import Lot, attr_overrides
+from .occlusion import first_pass, uses_occlusion
 from .shared import forget, share
 from .terminals import TerminalTable
 from .workers import Pool
@@ -125,25 +126,34 @@ def derive_lot(
     try:
         overrides = dict(job.attrs)
         overrides.update(attr_overrides(lot, job.values, warnings))
-        engine = Engine(
-            job.grammar,
-            job.seed,
-            overrides,
-            job.max_depth,
-            job.max_shapes,
-            lot_index=index,
-            warnings=warnings,
-            lot_name=name,
-            max_triangles=job.max_triangles,
-            max_memory=max_memory,
-            memory_base=memory_base(job),
-        )
+
+        def make_engine(warnings: Warnings) -> Engine:
+            made = Engine(
+                job.grammar,
+                job.seed,
+                overrides,
+                job.max_depth,
+                job.max_shapes,
+                lot_index=index,
+                warnings=warnings,
+                lot_name=name,
+                max_triangles=job.max_triangles,
+                max_memory=max_memory,
+                memory_base=memory_base(job),
+            )
+            made.shapes, made.triangles = shapes, triangles
+            return made
+
+        engine = make_engine(warnings)
+        if uses_occlusion(job.grammar):  # derived once with every query false (occlusion.py)
+            engine.occlusion = first_pass(
+                lambda: make_engine(Warnings()), lot.shape.copy(), job.start, index, job.several
+            )
         table = engine.table
         if cache is not None:
             engine.split_cache = cache
             engine.reuse.share(cache)
             share(engine, cache)
-        engine.shapes, engine.triangles = shapes, triangles
         try:
             engine.derive(lot.shape.copy(), job.start, index=index, several=job.several)
         finally:

@@ -169,6 +169,8 @@ class Engine:
         self._exprs: dict[int, object] = {}
         self._flat_ids: dict[tuple, int] = {}
         self._bare_ids: set[int] = set()  # the meshes of bare shapes (comp(e), comp(v))
+        self.solid_slabs: dict[tuple, object] = {}  # (mesh, axis, lo, hi) -> a split's piece
+        self.occlusion = None  # occlusion.Recorder or .Occluders when the grammar asks them
         self.split_cache: dict = {}  # (block id, sizes, length) -> placed pieces
         self.constant_sizes: dict[int, tuple | None] = {}  # id(entries) -> literal sizes
         # id(operation node) -> its signature (the grammar outlives us)
@@ -504,7 +506,13 @@ class Application:
         self.local = local
         # split.index/total and comp.index/total of the piece this shape came from stay visible
         self.ctx = Context(
-            shape, args, Stream(shape.hash), engine.seed, indices, engine.table.library
+            shape,
+            args,
+            Stream(shape.hash),
+            engine.seed,
+            indices,
+            engine.table.library,
+            engine.occlusion,
         )
         self.children: list = []
         self.counter = 0

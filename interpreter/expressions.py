@@ -15,7 +15,7 @@ from typing import Any
 
 from bgr.grammar import nodes as n
 from bgr.grammar.errors import BgrError, Diagnostic, source_line
-from bgr.grammar.registry import BUILTIN_NAMES
+from bgr.grammar.registry import BUILTIN_NAMES, OCCLUSION
 
 from .randomness import Stream, child_hash, name_hash, root_hash
 
@@ -56,6 +56,7 @@ class Context:
         "comp_right",
         "comp_sel",
         "library",
+        "occlusion",
     )
 
     def __init__(
@@ -66,13 +67,15 @@ class Context:
         seed: int,
         indices=(0, 1, 0, 1, 0.0, 0.0, ""),
         library=None,
+        occlusion=None,
     ) -> None:
         """``indices``: split.index, split.total, comp.index, comp.total, the comp face's left
         and right neighbour angles and its selector, of the piece the shape came from;
         ``library``: the derivation's unit meshes, which the geometry functions measure a mesh
-        shape by."""
+        shape by; ``occlusion``: the lot's occluders (occlusion.py), None when the grammar asks
+        no occlusion query."""
         self.shape, self.args, self.stream, self.seed = shape, args, stream, seed
-        self.library = library
+        self.library, self.occlusion = library, occlusion
         (
             self.split_index,
             self.split_total,
@@ -402,11 +405,18 @@ class Compiler:
 
     def call(self, e: n.Call, local: frozenset) -> Compiled:
         module, pos, name = self.module, e.pos, e.name
-        if name == "geometry.area" and e.args:  # a face selector: a bare word, not a value
-            from .geometry.queries import area
+        if name in ("geometry.area", "geometry.angle") and e.args:  # a bare word, not a value
+            from .geometry.queries import angle, area
 
-            selector = e.args[0].name  # type: ignore[union-attr]  # the checker made sure
-            return lambda ctx: area(ctx.shape, ctx.library, selector)
+            word = e.args[0].name  # type: ignore[union-attr]  # the checker made sure
+            query = area if name == "geometry.area" else angle
+            return lambda ctx: query(ctx.shape, ctx.library, word)
+        if name in OCCLUSION:  # inside(target, label): a bare word, then a value
+            from .occlusion import query
+
+            target = e.args[0].name if e.args else "all"  # type: ignore[union-attr]
+            label = self.expr(e.args[1], local) if len(e.args) > 1 else None
+            return lambda ctx: query(ctx, name, target, None if label is None else label(ctx))
         args = [self.expr(a, local) for a in e.args]
         if name == "rand":
 

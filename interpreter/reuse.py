@@ -22,7 +22,7 @@ from collections import OrderedDict
 from dataclasses import dataclass
 
 from bgr.grammar import nodes as n
-from bgr.grammar.registry import OPERATIONS
+from bgr.grammar.registry import OCCLUSION, OPERATIONS
 
 from .expressions import RuleRef
 from .geometry.polygons import RECT
@@ -46,6 +46,7 @@ PLACED = {
     "seed",
 }
 RANDOM = {"rand", "randint", "p"}
+OCCLUDED = set(OCCLUSION)  # occlusion queries: their answer depends on the lot around the shape
 # a subtree of up to this many terminals is kept the first time it is derived (a tile, a floor);
 # a larger one the second time (grid_city at n = 20: 1.34 s and 374 MB keeping all the first
 # time, 1.65 s and 281 MB keeping all the second time)
@@ -249,7 +250,7 @@ def _expr_ok(
         target, member = module.lookup_module(node.name)  # a rule handed on as a value
         return member not in target.rules or _reusable(target, member, known)
     if isinstance(node, n.Call):
-        if node.name in RANDOM:
+        if node.name in RANDOM or node.name in OCCLUDED:
             return False
         if not all(_expr_ok(module, a, known, local, seen) for a in node.args):
             return False

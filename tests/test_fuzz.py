@@ -48,6 +48,7 @@ from bgr.grammar.registry import (
     OPERATIONS,
     PRIMITIVES,
     ROOF_KINDS,
+    WORD_ARGUMENTS,
 )
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -401,9 +402,11 @@ class _Gen:
                 b = BUILTINS[name]
                 count = self.d(st.integers(b.least, b.most if b.most is not None else b.least + 2))
             toks = [name, "("]
-            if name == "geometry.area" and count:  # its argument is a face selector word
-                return toks + [self.pick(["top", "side", "all"]), ")"]
-            for i in range(count):
+            first = 0
+            if name in WORD_ARGUMENTS and count:  # its first argument is a bare word
+                toks.append(self.pick(list(WORD_ARGUMENTS[name])))
+                first = 1
+            for i in range(first, count):
                 if i:
                     toks.append(",")
                 toks += self.expr(names, funcs, depth - 1)[0]

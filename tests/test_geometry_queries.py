@@ -111,3 +111,36 @@ def test_area_of_the_faces_a_selector_takes():
     assert sizes["B"] == pytest.approx([200.0, 300.0, 50.0])
     with pytest.raises(bgr.BgrError, match="takes a face selector"):
         bgr.load("version 1\nterminal B\nLot --> s(geometry.area(3), 1, 1) B")
+
+
+def test_geometry_angle_of_a_gable_roofs_faces():
+    # the reference's example colours a cone's faces by geometry.angle(maxSlope) / 90 and by
+    # geometry.angle(azimuth) / 360; here a gable roof's slopes and gable ends are measured
+    sizes = measured(
+        "Lot --> extrude(4) comp(f) { top: Roof }\n"
+        "Roof --> roof(gable, 30) comp(f) { all: s(geometry.angle(maxSlope) + 1, "
+        'geometry.angle(azimuth) + 1, geometry.angle(zenith) + 1) label("f" + comp.index) F }\n'
+        "terminal F\n",
+        lot=(10, 8),
+    )
+    got = sorted(
+        (round(s[0] - 1, 6), round(s[1] - 1, 6), round(s[2] - 1, 6)) for s in sizes.values()
+    )
+    # two 30-degree slopes facing north (0) and south (180), two gable ends facing east and west
+    assert got == [(30.0, 0.0, 60.0), (30.0, 180.0, 60.0), (90.0, 90.0, 0.0), (90.0, 270.0, 0.0)]
+
+
+def test_geometry_angle_of_a_lot_and_a_turned_box():
+    sizes = measured(
+        "Lot --> [ s(geometry.angle(maxSlope) + 1, geometry.angle(zenith), 1) Flat ]\n"
+        "    [ extrude(3) r(0, 45, 0) s(geometry.angle(maxSlope), 1, 1) Box ]\n"
+        "terminal Flat, Box\n"
+    )
+    assert sizes["Flat"] == pytest.approx([1.0, 90.0, 1.0])  # a level lot: no slope
+    assert sizes["Box"] == pytest.approx([90.0, 1.0, 1.0])  # its walls
+
+
+@pytest.mark.parametrize("call", ["geometry.angle(steep)", "geometry.angle(1)", "geometry.angle()"])
+def test_geometry_angle_takes_one_of_its_words(call):
+    with pytest.raises(bgr.BgrError):
+        bgr.load(f"Lot --> s({call}, 1, 1) A\nterminal A\n")

@@ -83,3 +83,26 @@ def test_trimming_is_off_until_set_and_set_false_turns_it_off():
         result = bgr.derive(bgr.load(text), lot=(10.0, 10.0))
         assert np.allclose(result.mesh.bounds[0][[0, 2]], [-2.0, -2.0], atol=1e-9)
         assert len(result.mesh.faces) == 4 * 12
+
+
+def test_the_trim_operation_cuts_the_shapes_own_geometry():
+    # CGA's trim(): a façade made 20 % wider than its wall is cut back at the corners' mitres,
+    # with trimming on; with it off, or with no plane crossing the shape, nothing changes
+    src = (
+        "attr on = true\n"
+        "Lot --> set(trim.vertical, on) extrude(6) comp(f) { front: Wide }\n"
+        "Wide --> s('1.2, '1, '1) center(x) [ report(\"before\", geometry.area()) ] trim()\n"
+        "    report(\"after\", geometry.area()) s('1.2, '1, '1) center(x) extrude(0.5) trim()\n"
+        '    report("slab", geometry.area(top)) NIL\n'
+    )
+    grammar = bgr.load(src)
+    (lot,) = bgr.derive(grammar, lot=(10, 8)).reports
+    got = {k: v["sum"] for k, v in lot["reports"].items()}
+    assert got["before"] == pytest.approx(12 * 6)
+    assert got["after"] == pytest.approx(10 * 6)
+    # a slab as wide again pushed out 0.5 m from the wall, cut by the 45-degree mitres: 10 m
+    # wide at the wall, 11 m at its outer face (the cuts stay open, as CGA's trims)
+    assert got["slab"] == pytest.approx(11 * 6)
+    (lot,) = bgr.derive(grammar, lot=(10, 8), attrs={"on": False}).reports
+    got = {k: v["sum"] for k, v in lot["reports"].items()}
+    assert got["after"] == pytest.approx(12 * 6)

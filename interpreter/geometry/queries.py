@@ -68,9 +68,35 @@ def _selected(normals: np.ndarray, selector: str) -> np.ndarray:
         "back": level & ~sideways & (z > 0),
         "vertical": slope < 1.0,
         "horizontal": slope > 89.0,
-        "aslant": (slope >= 1.0) & (slope <= 89.0),
+        "aslant": (slope >= 1.0) & (slope <= 89.0) & (y > 0),
+        "nutant": (slope >= 1.0) & (slope <= 89.0) & (y < 0),
     }
     return chosen[selector]
+
+
+def angle(shape, library, kind: str) -> float:
+    """CGA's geometry.angle: ``maxSlope`` the steepest face against the world's horizontal
+    plane, in degrees; ``zenith`` 90 minus that; ``azimuth`` the compass direction that face
+    looks to, clockwise from north (-z in bgr's world, as in CityEngine's; east, +x, is 90).
+    A shape without faces has a slope of 0."""
+    tri = _corners(shape, library)
+    if not len(tri):
+        return 90.0 if kind == "zenith" else 0.0
+    axes = np.asarray(shape.axes, dtype=np.float64)
+    cross = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]) @ axes  # in world axes
+    sizes = np.linalg.norm(cross, axis=1)
+    keep = sizes > 1e-12 * max(float(sizes.max()), 1e-300)
+    normals = cross[keep] / sizes[keep, None]
+    slopes = np.degrees(np.arccos(np.clip(np.abs(normals[:, 1]), 0.0, 1.0)))
+    steepest = int(np.argmax(slopes))
+    if kind == "maxSlope":
+        return float(slopes[steepest])
+    if kind == "zenith":
+        return float(90.0 - slopes[steepest])
+    east, north = normals[steepest, 0], -normals[steepest, 2]
+    if abs(east) < 1e-12 and abs(north) < 1e-12:
+        return 0.0
+    return float(np.degrees(np.arctan2(east, north)) % 360.0)
 
 
 def volume(shape, library) -> float:

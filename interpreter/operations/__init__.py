@@ -10,6 +10,7 @@ from . import (
     appearance,
     attributes,
     components,
+    envelope,
     inserts,
     parts,
     reporting,
@@ -19,6 +20,7 @@ from . import (
     splits,
     texturing,
     transforms,
+    trims,
 )
 
 IMPLEMENTATIONS = {
@@ -40,11 +42,13 @@ IMPLEMENTATIONS = {
     "setback": setbacks.setback,
     "innerRectangle": setbacks.inner_rectangle,
     "extrude": components.extrude,
+    "envelope": envelope.envelope,
     "footprint": components.footprint,
     "polygon": components.polygon,
     "taper": components.taper,
     "roof": roofs.roof,
     "i": inserts.insert,
+    "trim": trims.trim,
     "color": appearance.color,
     "material": appearance.material,
     "label": appearance.label,

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from ..expressions import runtime_error
+from ..occlusion import note
 
 
 def _channel(app, step, value) -> float:
@@ -45,4 +46,5 @@ def material(app, shape, step, args) -> bool:
 
 def label(app, shape, step, args) -> bool:
     shape.label = str(args[0])
+    note(app, shape, shape.label)  # a labelled occluder, for inside(all, "name") and the rest
     return False

@@ -21,6 +21,7 @@ from ..geometry.polygons import (
 from ..geometry.polygons import (
     normalise as normalise_polys,
 )
+from ..occlusion import note
 from ..shapes import Flat, Prism, Solid, cross, dot, normalise
 from ..terminals import UnitMesh
 from .extrude_faces import extrude_faces
@@ -149,7 +150,7 @@ def _left_right(rings, nrm, turns) -> tuple[float, float]:
 
 # solids whose planar faces comp(f) takes apart: a roof's slopes and gable ends, a taper's caps
 # and sides, an extrusion along world y (assets and the round primitives are left whole)
-_MESH_FACES = ("roof", "taper", "extrusion")
+_MESH_FACES = ("roof", "taper", "extrusion", "envelope")
 
 
 def _face_shape(shape, rings, nrm):
@@ -183,13 +184,14 @@ def _face_shape(shape, rings, nrm):
     return face
 
 
-_BOXES = ("cube", "extrusion")  # solids whose walls get trim planes, as a prism's do
+_BOXES = ("cube", "extrusion", "envelope")  # solids whose walls get trim planes, as a prism's do
 
 
 def comp_faces(app, shape, step) -> bool:
     """comp(f): each face a 2D shape of its own (LANGUAGE.md section 7)."""
     faces = faces_of(app, step, shape)
     check_budget(app, step, len(faces), "faces")
+    first = app.counter
     answers = [words(nrm) for _, nrm, _ in faces]
     geom = shape.geom
     walls = isinstance(geom, Prism) or (isinstance(geom, Solid) and geom.name in _BOXES)
@@ -205,6 +207,7 @@ def comp_faces(app, shape, step) -> bool:
                 wall = walls and abs(nrm[1]) <= 0.7071
                 face.trims = corner_planes(face, *corners) if wall else ()
             app.piece(face, entry.body, comp=(j, len(chosen), *corners, selector))
+    note(app, shape, first=first)  # a mass turning into surfaces occludes (occlusion.py)
     return True
 
 
@@ -234,6 +237,13 @@ def _pieces(polys, su: float, sv: float, distance: float) -> dict:
 
 
 def offset(app, shape, step, args) -> bool:
+    first = app.counter
+    done = _offset(app, shape, step, args)
+    note(app, shape, first=first)  # as comp's shape, an occluder (occlusion.py)
+    return done
+
+
+def _offset(app, shape, step, args) -> bool:
     if not isinstance(shape.geom, Flat):
         # a solid: each of its faces is offset in its own plane, as CGA offsets every face
         faces = faces_of(app, step, shape)

@@ -14,6 +14,7 @@ from __future__ import annotations
 import math
 
 from ..geometry.edges import edges, vertices
+from ..occlusion import note
 from ..shapes import Solid, cross, dot, normalise
 from .components import comp_faces, faces_of
 from .selection import check_budget, select, words
@@ -21,11 +22,12 @@ from .selection import check_budget, select, words
 
 def comp(app, shape, step, args) -> bool:
     kind = args[0]
-    if kind == "e":
-        return comp_edges(app, shape, step)
-    if kind == "v":
-        return comp_vertices(app, shape, step)
-    return comp_faces(app, shape, step)
+    if kind == "f":
+        return comp_faces(app, shape, step)
+    first = app.counter
+    done = comp_edges(app, shape, step) if kind == "e" else comp_vertices(app, shape, step)
+    note(app, shape, first=first)  # as comp_faces' shape, an occluder (occlusion.py)
+    return done
 
 
 def _frame(x, y_hint) -> tuple[list[float], list[float], list[float]]:

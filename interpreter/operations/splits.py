@@ -14,9 +14,11 @@ from bgr.grammar import nodes as n
 from ..expressions import runtime_error
 from ..geometry.meshes import PLANE_AXES
 from ..geometry.polygons import RECT, clip, renormalise
+from ..geometry.slicing import slab
 from ..limits import format_bytes
 from ..shapes import Flat, Prism, Solid
 from ..split_solver import Piece, Repeat, SplitError, solve
+from ..terminals import UnitMesh
 
 
 def _constant(entries) -> tuple | None:
@@ -73,14 +75,7 @@ def _items(entries, sizes: tuple) -> tuple:
 def _clip(app, step, geom, axis: int, lo: float, hi: float):
     """The piece of a geometry between unit coordinates lo and hi along ``axis``; None if empty."""
     if isinstance(geom, Solid):
-        if geom.name == "cube":
-            return geom
-        raise runtime_error(
-            app.module,
-            step.pos,
-            f"split of a '{geom.name}' shape is not supported",
-            "split the footprint or the faces (comp(f)) instead of the solid",
-        )
+        return geom if geom.name == "cube" else _clip_solid(app, geom, axis, lo, hi)
     if axis == geom.k:
         return geom if isinstance(geom, Prism) else None
     if geom.polys == RECT:
@@ -90,6 +85,29 @@ def _clip(app, step, geom, axis: int, lo: float, hi: float):
     if not polys:
         return None
     return type(geom)(geom.k, polys, geom.name)
+
+
+def _clip_solid(app, geom: Solid, axis: int, lo: float, hi: float):
+    """A mesh solid's slab between unit coordinates lo and hi, closed where it was closed
+    (geometry.slicing); an edge's or a vertex's bare geometry stays as it is.  The slabs of a
+    mesh are made once per derivation (a roof split into the same tiles on every house)."""
+    engine = app.engine
+    key = (geom.mesh, axis, lo, hi)
+    found = engine.solid_slabs.get(key, _MISSING)
+    if found is _MISSING:
+        unit = engine.table.library.meshes[geom.mesh]
+        if len(unit.faces) == 0:
+            found = geom
+        else:
+            verts, faces = slab(unit.vertices, unit.faces, axis, lo, hi)
+            # an asset's texture coordinates do not survive the cut: the slab is bare
+            piece = UnitMesh(unit.name, verts, faces)
+            found = Solid(engine.table.library.add(piece), geom.name) if len(faces) else None
+        engine.solid_slabs[key] = found
+    return found
+
+
+_MISSING = object()
 
 
 def split(app, shape, step, args) -> bool:

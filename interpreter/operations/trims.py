@@ -24,7 +24,9 @@ import math
 
 import numpy as np
 
-from ..shapes import Shape
+from ..geometry.meshes import PLANE_AXES
+from ..geometry.polygons import RECT, from_shapely, is_unit_square, normalise
+from ..shapes import Flat, Prism, Shape, Solid
 from ..terminals import UnitMesh
 
 _EPS = 1e-9
@@ -77,6 +79,39 @@ def relative(shape: Shape) -> tuple:
     )
 
 
+def trim(app, shape: Shape, step, args):
+    """CGA's trim(): the shape's geometry cut by its trim planes now; a 2D shape or a prism
+    becomes the mesh of what is left (only when a plane crosses it)."""
+    if not shape.trims or all(_least(shape, n, c) >= 0 for n, c in shape.trims):
+        return False
+    geom = shape.geom
+    if not isinstance(geom, Solid):  # cut as a mesh, and a prism stays a solid comp(f) opens
+        name = "extrusion" if isinstance(geom, Prism) else geom.name
+        shape.geom = Solid(app.engine.mesh_id(geom), name)
+    if not trim_insert(app, shape):
+        return DELETED
+    if isinstance(geom, Flat):  # what is left of a 2D shape is a 2D shape again
+        _flat_again(app, shape, geom.k)
+    return False
+
+
+def _flat_again(app, shape: Shape, k: int) -> None:
+    """A trimmed 2D shape's mesh back to its outline (Flat), its scope fitted to it."""
+    import shapely
+    from shapely.geometry import Polygon
+
+    mesh = app.engine.table.library.meshes[shape.geom.mesh]
+    p, q = PLANE_AXES[k]
+    metres = mesh.vertices * np.asarray(shape.size, dtype=np.float64)
+    flat = metres[:, [p, q]]
+    merged = shapely.union_all([Polygon(flat[f]) for f in mesh.faces if len(set(f)) == 3])
+    unit, (x0, y0, w, h) = normalise(from_shapely(merged))
+    axes = shape.axes
+    shape.origin = [shape.origin[i] + x0 * axes[p][i] + y0 * axes[q][i] for i in range(3)]
+    shape.size[p], shape.size[q] = w, h
+    shape.geom = Flat(k, RECT if is_unit_square(unit) else unit)
+
+
 def trim_insert(app, shape: Shape) -> bool:
     """Cut the shape's inserted mesh by its trim planes; False when nothing of it is left."""
     if not shape.trims or all(_least(shape, n, c) >= 0 for n, c in shape.trims):
@@ -89,11 +124,10 @@ def trim_insert(app, shape: Shape) -> bool:
     verts, faces, uv = mesh.vertices, mesh.faces, mesh.uv
     changed = False
     for normal, c in shape.trims:
-        # the plane in the mesh's unit coordinates: u = ((w - o) . a_i) / s_i
-        point = np.asarray(normal) * c  # the plane's point nearest the world's origin
-        p = np.divide((point - origin) @ axes.T, size, out=np.zeros(3), where=size > 0)
+        # a vertex's signed distance in the mesh's unit coordinates: its world point is
+        # origin + (u * size) @ axes (no division by a size, which is 0 across a face)
         n = (axes @ np.asarray(normal)) * size
-        side = (verts - p) @ n
+        side = verts @ n + (float(origin @ np.asarray(normal)) - c)
         scale = float(np.abs(n).max()) or 1.0
         if (side >= -_EPS * scale).all():
             continue
