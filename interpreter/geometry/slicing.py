@@ -8,16 +8,19 @@ section (``cap``) with earcut; an open mesh (a roof without its underside) is cu
 from __future__ import annotations
 
 import numpy as np
-import trimesh
 
 
-def _mesh(vertices: np.ndarray, faces: np.ndarray) -> trimesh.Trimesh:
+def _mesh(vertices: np.ndarray, faces: np.ndarray):
+    import trimesh  # 0.36 s to import: only a derivation that cuts a solid pays it
+
     return trimesh.Trimesh(vertices=vertices, faces=faces, process=True, validate=False)
 
 
 def keep_side(vertices, faces, planes) -> tuple[np.ndarray, np.ndarray]:
     """The part of a mesh on the kept side of every plane (normal, point): normal . (p - point)
     >= 0.  Empty arrays when nothing is left."""
+    import trimesh
+
     mesh = _mesh(np.asarray(vertices, float), np.asarray(faces, np.int64))
     for normal, point in planes:
         if len(mesh.faces) == 0:
