@@ -187,11 +187,14 @@ class Imported:
     outputs: dict[Path, str] = field(default_factory=dict)
     warnings: list[Diagnostic] = field(default_factory=list)
     attrs: dict[Path, dict[str, str]] = field(default_factory=dict)  # CGA name -> bgr name
+    # per output: (CGA rule, arity) -> bgr rule, what an importer's overrides name
+    rules: dict[Path, dict[tuple[str, int], str]] = field(default_factory=dict)
 
 
 def translate_file(source: Path, output: Path) -> Imported:
     """Translate ``source`` (and the CGA files it imports) into ``output`` (and beside it)."""
     from ..grammar.formatter import format_module
+    from . import overrides
 
     result = Imported()
     busy: list[Path] = []
@@ -203,7 +206,7 @@ def translate_file(source: Path, output: Path) -> Imported:
         assets = Assets(src.parent, out.parent)
         busy.append(src.resolve())
 
-        def resolve_import(target: str, meta) -> tuple[str, dict] | None:
+        def resolve_import(target: str, meta) -> tuple[str, dict, dict] | None:
             found = find(target, src.parent)
             line, column = getattr(meta, "line", 0), getattr(meta, "column", 0)
             if found is None:
@@ -242,7 +245,7 @@ def translate_file(source: Path, output: Path) -> Imported:
                     Diagnostic(**{**d.__dict__, "severity": "warning"}) for d in e.diagnostics
                 ]
                 return None
-            return target_out.name, result.attrs[target_out]
+            return target_out.name, result.attrs[target_out], result.rules[target_out]
 
         tr = Translator(tree, comments, text, str(src), assets, resolve_import)
         module = tr.module()
@@ -260,6 +263,7 @@ def translate_file(source: Path, output: Path) -> Imported:
             )
         result.outputs[out] = format_module(module)
         result.attrs[out] = dict(tr.attrs)
+        result.rules[out] = overrides.rules_of(tr)
         rules = module.rules()
         for decl, items in style_blocks(tree):
             if not rules:

@@ -16,6 +16,7 @@ from typing import TYPE_CHECKING
 from lark import Tree
 
 from ..grammar import nodes as n
+from ..grammar.cga_table import OPERATION_NAMES as CGA_OPERATIONS
 from ..grammar.registry import (
     CLEANUP_KINDS,
     NUMBER_OR_WORD,
@@ -26,7 +27,7 @@ from ..grammar.registry import (
     TEX_SIZE,
     UP_AXES,
 )
-from . import media
+from . import media, overrides
 from .expressions import dotted, pos, unquote
 
 if TYPE_CHECKING:
@@ -93,9 +94,6 @@ DROPPED = {
     "splitAndSetbackPerimeter",
     "insertAlongUV",
     "scatter",
-    "shapeL",
-    "shapeU",
-    "shapeO",
     "splitArea",
     "roofRamp",
     "texture3D",
@@ -124,6 +122,13 @@ def operation(tr: Translator, name: str, args: list, block, meta, rest: list) ->
     if name == "setback" and block is not None and len(args) == 1 and not _is_fcall_block(args[0]):
         body = tr.block(block, "setback")
         return _with_block(tr, "setback", [tr.expr(args[0])], body, meta), True
+    if name in ("shapeL", "shapeU", "shapeO") and block is not None:
+        body = tr.block(block, "innerRectangle")
+        return _with_block(tr, name, [tr.expr(a) for a in args], body, meta), True
+    if name == "setback" and block is not None and len(args) == 1 and _same_distance(args[0]):
+        # setback(comp(fe) { all: d }): every edge the same distance, as setback(d)
+        distance = tr.expr(_same_distance(args[0]))
+        return _with_block(tr, "setback", [distance], tr.block(block, "setback"), meta), True
     if name in ("innerRectangle", "innerRect") and block is not None:
         if not args or _word(args[0]) != "scope":
             tr.warn(meta, "innerRectangle() along the scope's axes only in bgr (scope)")
@@ -167,6 +172,8 @@ def operation(tr: Translator, name: str, args: list, block, meta, rest: list) ->
             return [n.Nil(pos=where)], True
         tr.warn(meta, f"{name}() is not in bgr yet; it is left out and the shape goes on as it was")
         return [], False
+    if name not in CGA_OPERATIONS:  # a rule the file calls but does not define
+        return [overrides.placeholder(tr, name, args, meta)], False
     tr.warn(meta, f"unknown operation '{name}'; it is left out")
     return [], False
 
@@ -263,6 +270,19 @@ def comp(tr: Translator, args: list, block: Tree, meta) -> list:
     if len(args) > 1:
         tr.warn(meta, "comp()'s scope alignment (noAlign) is not in bgr; it is left out")
     return _with_block(tr, "comp", [n.Name(kind)], tr.block(block, f"comp:{kind}"), meta)
+
+
+def _same_distance(t):
+    """The distance of ``comp(fe) { all: d }`` (one entry, every edge), else None."""
+    calls = [c for c in t.iter_subtrees() if c.data == "fcall_block"] if isinstance(t, Tree) else []
+    if len(calls) != 1 or dotted(calls[0].children[0]) != "comp":
+        return None
+    call = calls[0]
+    entries = [c for c in call.children if isinstance(c, Tree) and c.data == "value_entry"]
+    if calls[0] is not t or len(entries) != 1:
+        return None
+    key, value = entries[0].children
+    return value if _word(key) == "all" else None
 
 
 def _is_fcall_block(t) -> bool:

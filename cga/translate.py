@@ -39,7 +39,7 @@ from ..grammar.registry import (
     SETBACK_SELECTORS,
     VERTEX_SELECTORS,
 )
-from . import media
+from . import media, overrides
 from . import operations as ops
 from .expressions import Expressions, dotted, pos, unquote
 from .start import At, prepend_to_start, shape_attrs
@@ -74,7 +74,7 @@ class Translator:
         text: str,
         path: str,
         assets,
-        imports: Callable[[str, object], tuple[str, dict] | None],
+        imports: Callable[[str, object], tuple[str, dict, dict] | None],
     ) -> None:
         self.tree, self.comments, self.text, self.path = tree, comments, text, path
         self.assets, self.resolve_import = assets, imports
@@ -86,6 +86,9 @@ class Translator:
         self.attrs: dict[str, str] = {}
         self.consts: dict[str, str] = {}
         self.imports: dict[str, str | None] = {}
+        # per import alias: (CGA rule, arity) -> its bgr name there (overrides.rules_of)
+        self.import_rules: dict[str, dict[tuple[str, int], str]] = {}
+        self.undefined: dict[tuple[str, int], str] = {}  # rules called but not defined here
         self.terminals: dict[str, str] = {}  # CGA leaf name -> bgr terminal
         self.taken: set[str] = set()
         self.params: dict[str, str] = {}
@@ -267,11 +270,9 @@ class Translator:
                 self.drop_notes(notes, "a function")
                 items.append(self.func(item))
             elif kind == "rule" and "." in str(item.children[0]):
-                self.warn(
-                    item.meta,
-                    f"overriding rule '{item.children[0]}' of an import is not "
-                    "in bgr yet; the imported rule is used",
-                )
+                found = overrides.override(self, item, notes)
+                items += ([found] if found is not None else []) + self.extra
+                self.extra = []
             elif kind == "rule":
                 items.append(self.rule(item, notes))
                 items += self.extra
@@ -348,7 +349,7 @@ class Translator:
         if found is None:
             self.imports[alias] = None
             return
-        bgr_path, their_attrs = found
+        bgr_path, their_attrs, self.import_rules[alias] = found
         name = self.fresh(alias, ("scope", "split", "comp", "stdlib"))
         self.imports[alias] = name
         items.append(n.Import(name, path=bgr_path, pos=pos(t.meta)))
@@ -448,7 +449,7 @@ class Translator:
     def helper(self, body: n.Body, where: n.Pos) -> n.Successor:
         """A new rule with the current rule's parameters and ``body``; its successor."""
         self.helpers += 1
-        name = self.fresh(f"{self.rule_name}_{self.helpers}", OPERATIONS)
+        name = self.fresh(f"{self.rule_name.replace('.', '_')}_{self.helpers}", OPERATIONS)
         self.extra.append(n.Rule(name, list(self.rule_params), body, pos=where))
         return n.Successor(name, [n.Name(p) for p in self.rule_params], pos=where)
 

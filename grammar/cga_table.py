@@ -88,15 +88,15 @@ CGA: list[tuple[str, str, str, str]] = [
         "setback",
         PARTLY,
         "",
-        "one distance, the scope's edge selectors, side, all and remainder; a distance per "
-        "edge, street and uv selectors not yet",
+        "one distance (`comp(fe) { all: d }` too), the scope's edge selectors, side, all and "
+        "remainder; distances that differ per edge, street and uv selectors not yet",
     ),
     ("setNormals", NOT_YET, "", ""),
     ("setPivot", NOT_YET, "", ""),
     ("setupProjection", SAME, "", ""),
-    ("shapeL", DIFFERENT, "footprint(L, a, b)", "wing widths as fractions of the scope"),
-    ("shapeO", DIFFERENT, "footprint(circle, sides)", "a ring of sides"),
-    ("shapeU", DIFFERENT, "footprint(U, a, b)", ""),
+    ("shapeL", SAME, "", "`footprint(L, a, b)` makes an L of wing fractions instead"),
+    ("shapeO", SAME, "", ""),
+    ("shapeU", SAME, "", ""),
     ("softenNormals", NOT_YET, "", ""),
     ("split", SAME, "", "absolute, `'` relative and `~` floating sizes, `{ ... }*` repeats"),
     ("splitArea", NOT_YET, "", ""),
@@ -174,8 +174,8 @@ CGA: list[tuple[str, str, str, str]] = [
         "import",
         DIFFERENT,
         'import "file.bgr" as name',
-        "then `name.Rule`; a binding `(attr = v)` is `set(name.attr, v)` (import-cga); rule "
-        "overrides not yet",
+        "then `name.Rule`; a binding `(attr = v)` is `set(name.attr, v)` (import-cga); "
+        "`name.Rule --> ...` overrides the imported rule, as CGA's",
     ),
     ("scope.sx, scope.sy, scope.sz", SAME, "scope.sx, scope.sy, scope.sz", ""),
     ("scope.tx, scope.ty, scope.tz", DIFFERENT, "scope.x, scope.y, scope.z", ""),
@@ -194,6 +194,51 @@ CGA: list[tuple[str, str, str, str]] = [
         "(`set(base.attr, v)`) and runs the file's start rule",
     ),
 ]
+# CGA's operations (the first part of the list), and those its reference has beyond the
+# index above: a call of any other name in a CGA file is a rule's (bgr import-cga)
+OPERATION_NAMES = frozenset(
+    [name for name, *_ in CGA[: [e[0] for e in CGA].index("abs")]]
+    + [
+        "alignScopeToGeometryBBox",
+        "copyUV",
+        "deleteTags",
+        "inline",
+        "insertAlongUV",
+        "intersect",
+        "modify",
+        "mirrorScope",
+        "primitiveCone",
+        "primitiveDisk",
+        "primitiveTorus",
+        "rectify",
+        "reduceGeometry",
+        "resetGeometry",
+        "roofRidge",
+        "roofRamp",
+        "scatter",
+        "setbackPerEdge",
+        "setbackToArea",
+        "setNormals",
+        "setPivot",
+        "setTagsFromEdgeAttrs",
+        "shapeL",
+        "shapeO",
+        "shapeU",
+        "softenNormals",
+        "splitAndSetbackPerimeter",
+        "splitArea",
+        "subtract",
+        "tag",
+        "texture3D",
+        "tileUV3D",
+        "translate",
+        "rotate",
+        "union",
+        "deleteHoles",
+        "alignScopeToAxes3D",
+        "setMaterial",
+    ]
+)
 
 # registry entries CGA has no word for: bgr's own
 BGR_ONLY = {"matrix", "footprint", "polygon", "normalMap", "material", "roof", "clamp",

@@ -121,13 +121,20 @@ class Grammar:
     barren: dict[str, str] = field(default_factory=dict)  # rule -> its cycle (.productive)
     settable: set[str] = field(default_factory=set)  # attrs a set() of its rules changes
     occlusion: bool = False  # whether it asks inside(), overlaps() or touches() (occlusion.py)
+    # rules of this module that its importer overrides (``alias.Name --> ...`` there): member ->
+    # (the importer, the override's name in it); a module imported with overrides is a copy of
+    # its own (Loader), so other importers of the file keep its rules
+    overrides: dict[str, tuple[Grammar, str]] = field(default_factory=dict)
 
     def lookup_module(self, dotted: str) -> tuple[Grammar, str]:
         """Split ``alias.Name`` into (module, member); a plain name is this module's own."""
         if "." in dotted:
             alias, member = dotted.split(".", 1)
             if alias in self.imports:
-                return self.imports[alias], member
+                target = self.imports[alias]
+                return target.overrides.get(member) or (target, member)
+        if self.overrides and dotted in self.overrides:
+            return self.overrides[dotted]
         return self, dotted
 
 
@@ -214,6 +221,10 @@ class Checker:
                     )
                 else:
                     g.version = int(item.number)
+            elif isinstance(item, n.Rule) and "." in item.name:
+                if self.override(item) and declare("rule", item.name, item.pos, "rule"):
+                    g.rules[item.name] = item
+                self.unique_params(item, "rule")
             elif isinstance(item, n.Rule):
                 if item.name in OPERATIONS:
                     self.error(
@@ -285,8 +296,45 @@ class Checker:
                 )
                 self.error(item.pos, f"start rule '{item.name}' is not defined", hint)
                 break
-        if g.start is None and g.rules:
-            g.start = next(iter(g.rules))
+        if g.start is None and g.rules:  # the first rule of its own, not an override
+            g.start = next((r for r in g.rules if "." not in r), None)
+
+    def override(self, rule: n.Rule) -> bool:
+        """Whether ``alias.Name --> ...`` overrides a rule or terminal of an import (as CGA's
+        rule overriding): the imported module's own calls to Name run this rule instead."""
+        alias, member = rule.name.split(".", 1)
+        if alias in self.broken_aliases:
+            return False
+        target = self.g.imports.get(alias)
+        if target is None:
+            self.error(
+                rule.pos,
+                f"'{rule.name}' overrides a rule of '{alias}', which is not an import alias",
+                f'import the file first: import "FILE.bgr" as {alias}',
+                len(rule.name),
+            )
+            return False
+        if "." in member or (member not in target.rules and member not in target.terminals):
+            known = list(target.rules) + list(target.terminals)
+            self.error(
+                rule.pos,
+                f"'{alias}' has no rule or terminal '{member}' to override",
+                suggest(member, known) or f"its rules: {', '.join(known[:8])}",
+                len(rule.name),
+            )
+            return False
+        original = target.rules.get(member)
+        want = len(original.params) if original is not None else 0
+        if len(rule.params) != want:
+            self.error(
+                rule.pos,
+                f"'{rule.name}' takes {len(rule.params)} parameter"
+                f"{'' if len(rule.params) == 1 else 's'}, but the rule it overrides takes {want}",
+                "an override takes the parameters of the rule it replaces",
+                len(rule.name),
+            )
+            return False
+        return True
 
     def unique_params(self, item: n.Rule | n.Func, what: str) -> None:
         seen = set()

@@ -104,18 +104,32 @@ class Loader:
             return None
         folder = Path(key).parent if key else Path.cwd()
         grammar = Grammar(path, module, roots=self.roots, folder=folder)
+        # ``alias.Name --> ...``: rules this module overrides in the module imported as alias
+        overriding: dict[str, list[str]] = {}
+        for item in module.items:
+            if isinstance(item, n.Rule) and "." in item.name:
+                alias, member = item.name.split(".", 1)
+                overriding.setdefault(alias, []).append(member)
         broken: dict[str, bool] = {}
         for item in module.items:
             if isinstance(item, n.Import):
-                imported = self.load_import(item, folder, module, stack)
+                own = item.alias in overriding  # a copy of its own, which the overrides change
+                imported = self.load_import(item, folder, module, stack, fresh=own)
                 if imported is not None:
                     grammar.imports[item.alias] = imported
+                    for member in overriding.get(item.alias, []):
+                        imported.overrides[member] = (grammar, f"{item.alias}.{member}")
                 broken[item.alias] = imported is None
         self.diagnostics += Checker(grammar, broken).check()
         return grammar
 
     def load_import(
-        self, item: n.Import, folder: Path, module: n.Module, stack: tuple[str, ...]
+        self,
+        item: n.Import,
+        folder: Path,
+        module: n.Module,
+        stack: tuple[str, ...],
+        fresh: bool = False,
     ) -> Grammar | None:
         def fail(message: str, hint: str | None = None) -> None:
             self.diagnostics.append(
@@ -181,7 +195,7 @@ class Loader:
                 "a module cannot import itself, directly or through others",
             )
             return None
-        if key in self.done:
+        if key in self.done and not fresh:
             return self.done[key]
         if key in self.failed:
             return None
@@ -194,7 +208,7 @@ class Loader:
         grammar = self.load_text(text, shown, key, stack + (key,))
         if grammar is None:
             self.failed.add(key)
-        else:
+        elif not fresh:
             self.done[key] = grammar
         return grammar
 

@@ -174,7 +174,8 @@ OPERATIONS: dict[str, Op] = {
             _sig(),
             "Turn a 2D shape over so that it faces the other way (as CGA's operation of that "
             "name): a face's scope turns 180 degrees about its own y axis, so x and z reverse "
-            "and the outline stays where it is (a lot's turns about its z).",
+            "and the outline stays where it is (a lot's turns about its z); a solid's "
+            "triangles are each turned over in place.",
             "reverseNormals()",
         ),
         Op(
@@ -352,6 +353,24 @@ OPERATIONS: dict[str, Op] = {
             "of the last two; missing ones as the one before) cut by a plane through the edge at "
             "its base height, rising inward at its angle from the horizontal (90: a plain wall).",
             "envelope(world.up, 30, 12, 45, 8, 60)",
+        ),
+        *(
+            Op(
+                name,
+                "components",
+                _sig(*(Param(side, NUMBER) for side in sides)),
+                f"CGA's {name}: the strips of the given widths along the scope's "
+                f"{', '.join(sides)} sides of a 2D shape (front: low z, or low y on a face; "
+                "left: low x), joined and cut to its outline, are `shape`; the rest is "
+                "`remainder`.",
+                f"{name}({', '.join(['4'] * len(sides))}) {{ shape: Building | remainder: Yard }}",
+                block="innerRectangle",
+            )
+            for name, sides in (
+                ("shapeL", ("front", "left")),
+                ("shapeU", ("front", "right", "left")),
+                ("shapeO", ("front", "right", "back", "left")),
+            )
         ),
         Op(
             "taper",

@@ -178,3 +178,52 @@ def test_inner_rectangle_is_the_largest_rectangle_along_the_scope():
     assert ell.mesh.area == pytest.approx(20 * 7.5 + 8 * 7.5)
     box = bgr.derive(bgr.load(text.replace("FOOT ", "")), lot=(20.0, 15.0))
     assert list(box.terminals.label) == ["In"]
+
+
+@pytest.mark.parametrize(
+    "call, shape_area, pieces",
+    [
+        # CGA's shapeL(frontWidth, leftWidth): the front strip and the left one, as an L
+        ("shapeL(4, 5)", 20 * 4 + 5 * (15 - 4), 1),
+        # shapeU(front, right, left): three strips
+        ("shapeU(4, 3, 5)", 20 * 4 + (3 + 5) * (15 - 4), 1),
+        # shapeO(front, right, back, left): a ring round a courtyard of 12 x 8
+        ("shapeO(4, 3, 3, 5)", 20 * 15 - 12 * 8, 1),
+    ],
+)
+def test_shape_l_u_o_cut_strips_along_the_scope(call, shape_area, pieces):
+    src = f"version 1\nterminal In, Out\nLot --> {call} {{ shape: In | remainder: Out }}\n"
+    result = bgr.derive(bgr.load(src), lot=(20.0, 15.0))
+    labels = list(result.terminals.label)
+    assert labels.count("In") == pieces and labels.count("Out") == 1
+    areas = {"In": 0.0, "Out": 0.0}
+    for row, label in enumerate(labels):
+        mesh = result.terminals.library.meshes[result.terminals.mesh[row]]
+        pts = world_vertices(result.terminals, np.array([row]), mesh)[0]
+        areas[label] += float(trimesh.Trimesh(pts, mesh.faces, process=False).area)
+    assert areas["In"] == pytest.approx(shape_area)
+    assert areas["In"] + areas["Out"] == pytest.approx(20 * 15)
+    # the L's front strip lies along the street edge (z = 0) and its left strip at x = 0
+    if call.startswith("shapeL"):
+        row = labels.index("In")
+        low, high = bounds_of(result.terminals, row)
+        assert low[0] == pytest.approx(0) and low[2] == pytest.approx(0)
+
+
+def test_reverse_normals_of_a_solid_turns_its_triangles_over():
+    solid = bgr.derive(bgr.load("Lot --> extrude(3) reverseNormals() A\nterminal A\n"), lot=(4, 4))
+    plain = bgr.derive(bgr.load("Lot --> extrude(3) A\nterminal A\n"), lot=(4, 4))
+    # the same box, every face looking inward: its signed volume changes sign
+    assert solid.mesh.volume == pytest.approx(-plain.mesh.volume)
+    assert plain.mesh.volume == pytest.approx(48)
+
+
+def test_a_face_turned_into_a_mesh_still_comes_apart():
+    # alignScopeToAxes of a face on a turned mass leaves it a mesh in the new scope; extrude
+    # and comp(f) take it apart as a prism's faces
+    src = (
+        "Lot --> r(0, 30, 0) extrude(6) comp(f) { front: Front }\n"
+        "Front --> alignScopeToAxes(y) extrude(0.5) comp(f) { all: P }\nterminal P\n"
+    )
+    result = bgr.derive(bgr.load(src), lot=(10, 8))
+    assert len(result.terminals.label) == 6

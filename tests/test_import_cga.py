@@ -413,3 +413,28 @@ Lot --> NIL
     assert np.allclose(plain.terminals.color[0], [0x88 / 255] * 3, atol=1e-3)
     assert np.allclose(red.terminals.color[0], [0xCC / 255, 0, 0], atol=1e-3)
     assert red.terminals.size[0][1] == pytest.approx(12.0)
+
+
+def test_same_distance_setbacks_shapes_and_edges_translate(tmp_path):
+    # envelope2002's forms: setback(comp(fe) { all: d }) is setback(d); shapeL/U/O with their
+    # blocks; comp(e) with roof selectors; envelope along world.up
+    out, result = _import(
+        tmp_path,
+        """Lot --> shapeL(8, 6) { shape: Building | remainder: Yard }
+Building --> setback(comp(fe) { all : 2 }) { all : Rim | remainder : Core }
+Core --> extrude(9) comp(f) { top : Roof }
+Roof --> roofHip(30) comp(e) { ridge : Bar Ridge. | eave : Bar Eave. }
+Bar --> s('1, 0.2, 0.2) center(yz) primitiveCube()
+Rim --> envelope(world.up, 3, 1, 45) Rim.
+Yard --> color(0, 1, 0) Yard.
+""",
+    )
+    assert [w.message for w in result.warnings] == []
+    text = out.read_text()
+    assert "setback(2) { all: Rim | remainder: Core }" in text
+    assert "shapeL(8, 6) { shape: Building | remainder: Yard }" in text
+    labels = _labels(_derive(out))
+    # an L's hip roof: a bar on each of its two ridges and six eaves (the bare edges
+    # themselves, Ridge. and Eave., make nothing, as in CityEngine); eight strips round the L
+    assert labels["Bar"] == 2 + 6 and "Ridge" not in labels
+    assert labels["RimLeaf"] == 8 and labels["YardLeaf"] == 1

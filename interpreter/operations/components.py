@@ -150,7 +150,7 @@ def _left_right(rings, nrm, turns) -> tuple[float, float]:
 
 # solids whose planar faces comp(f) takes apart: a roof's slopes and gable ends, a taper's caps
 # and sides, an extrusion along world y (assets and the round primitives are left whole)
-_MESH_FACES = ("roof", "taper", "extrusion", "envelope")
+_MESH_FACES = ("roof", "taper", "extrusion", "envelope", "polygon", "prism")
 
 
 def _face_shape(shape, rings, nrm):

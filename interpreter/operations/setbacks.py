@@ -1,5 +1,6 @@
 """setback(distance) { selector: ... | remainder: ... }: CGA's setback of a 2D shape's edges
-(interpreter/geometry/setbacks.py holds the geometry)."""
+(interpreter/geometry/setbacks.py holds the geometry); innerRectangle, and shapeL, shapeU and
+shapeO, CGA's L, U and O (ring) shapes cut from a 2D shape's scope."""
 
 from __future__ import annotations
 
@@ -90,4 +91,50 @@ def inner_rectangle(app, shape, step, args) -> bool:
     for entry in step.block.entries:
         part = rect if entry.key.name == "shape" else rest
         _piece(app, shape, step, entry, part, p, q, geom.k)
+    return True
+
+
+# the sides each of CGA's shape operations takes a width for, in its arguments' order
+LUO_SIDES = {
+    "shapeL": ("front", "left"),
+    "shapeU": ("front", "right", "left"),
+    "shapeO": ("front", "right", "back", "left"),
+}
+
+
+def shape_luo(app, shape, step, args) -> bool:
+    """shapeL(front, left), shapeU(front, right, left), shapeO(front, right, back, left)
+    { shape: A | remainder: B }: as CGA's, the strips of those widths along the scope's sides
+    (front at its low z, or low y on a face; left at its low x), joined into an L, a U or a
+    ring and cut to the shape's outline; ``remainder`` is the rest."""
+    import shapely
+    from shapely.geometry import box
+
+    from ..geometry.polygons import from_shapely, metric, to_shapely
+
+    geom = shape.geom
+    if not isinstance(geom, Flat):
+        raise runtime_error(
+            app.module, step.pos, f"{step.name}() needs a 2D shape", "use it on a lot or a face"
+        )
+    p, q = PLANE_AXES[geom.k]
+    su, sv = shape.size[p], shape.size[q]
+    polys = [(UNIT_SQUARE, ())] if geom.polys == RECT else geom.polys
+    whole = to_shapely(metric(polys, su, sv))
+    strips_of = {
+        "front": lambda d: box(0.0, 0.0, su, d),
+        "back": lambda d: box(0.0, sv - d, su, sv),
+        "left": lambda d: box(0.0, 0.0, d, sv),
+        "right": lambda d: box(su - d, 0.0, su, sv),
+    }
+    widths = [float(v) for v in args[: len(step.args)]]
+    pieces = [
+        strips_of[side](min(width, max(su, sv)))
+        for side, width in zip(LUO_SIDES[step.name], widths, strict=True)
+        if width > 0
+    ]
+    part = whole.intersection(shapely.union_all(pieces)) if pieces else shapely.Polygon()
+    parts = {"shape": from_shapely(part), "remainder": from_shapely(whole.difference(part))}
+    for entry in step.block.entries:
+        _piece(app, shape, step, entry, parts[entry.key.name], p, q, geom.k)
     return True

@@ -8,7 +8,8 @@ import math
 from ..expressions import runtime_error
 from ..geometry.meshes import PLANE_AXES
 from ..geometry.polygons import RECT
-from ..shapes import Flat, cross, dot, normalise
+from ..shapes import Flat, Prism, Solid, cross, dot, normalise
+from ..terminals import UnitMesh
 
 
 def _amounts(app, step, shape, values) -> list[float]:
@@ -109,13 +110,15 @@ def reverse_normals(app, shape, step, args) -> bool:
     its x and z reverse; a lot (flat along y) about its z.
     """
     geom = shape.geom
-    if not isinstance(geom, Flat):
-        raise runtime_error(
-            app.module,
-            step.pos,
-            "reverseNormals() needs a 2D shape",
-            "turn a face over (from comp(f) or offset), not a solid",
-        )
+    if not isinstance(geom, Flat):  # a solid: every triangle turned over, as CGA does
+        library = app.engine.table.library
+        mesh = library.meshes[app.engine.mesh_id(geom)]
+        turned = UnitMesh(mesh.name, mesh.vertices, mesh.faces[:, ::-1], mesh.uv, mesh.image)
+        if mesh.uv is not None:
+            turned.uv = mesh.uv[:, ::-1]
+        name = "extrusion" if isinstance(geom, Prism) else geom.name
+        shape.geom = Solid(library.add(turned), name)
+        return False
     k = geom.k
     about = 2 if k == 1 else 1
     flipped = [a for a in range(3) if a != about]  # the normal and one axis in the plane
