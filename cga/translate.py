@@ -458,14 +458,20 @@ class Translator:
         return n.Sequence(out, pos=where) if out else _nothing()
 
     def steps(self, trees: list) -> list:
+        """CGA's NIL is a successor that makes nothing: the steps after it still run on the
+        shape (``report(..) NIL report(..) NIL`` reports twice), which bgr's NIL would end, so
+        a NIL with steps after it moves to the end of the sequence."""
         out: list = []
+        deleted = None
         for k, t in enumerate(trees):
             rest = trees[k + 1 :]
             made, took_rest = self.step(t, rest)
-            out += made
-            if took_rest or any(isinstance(s, n.Nil) for s in made):
+            nils = [s for s in made if isinstance(s, n.Nil)]
+            out += [s for s in made if not isinstance(s, n.Nil)]
+            deleted = deleted or (nils[0] if nils else None)
+            if took_rest:
                 break
-        return out
+        return out + [deleted] if deleted is not None else out
 
     def step(self, t, rest: list) -> tuple[list, bool]:
         if isinstance(t, Token) and t.type == "NIL":

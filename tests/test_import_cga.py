@@ -438,3 +438,18 @@ Yard --> color(0, 1, 0) Yard.
     # themselves, Ridge. and Eave., make nothing, as in CityEngine); eight strips round the L
     assert labels["Bar"] == 2 + 6 and "Ridge" not in labels
     assert labels["RimLeaf"] == 8 and labels["YardLeaf"] == 1
+
+
+def test_nil_in_the_middle_of_a_sequence_lets_the_rest_run(tmp_path):
+    # CGA's NIL is a successor that makes nothing: envelope2002's
+    # comp(f) { top: report(..) NIL report(..) NIL } reports twice
+    out, _ = _import(
+        tmp_path,
+        'Lot --> extrude(3) comp(f) { top: report("a", 1) NIL report("b", 2) NIL }\n'
+        'X --> NIL report("c", 3)\n',
+    )
+    text = out.read_text()
+    assert 'report("a", 1) report("b", 2) NIL' in text
+    assert 'X --> report("c", 3) NIL' in text
+    (lot,) = _derive(out).reports
+    assert {k: v["sum"] for k, v in lot["reports"].items()} == {"a": 1, "b": 2}
