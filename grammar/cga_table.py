@@ -20,7 +20,12 @@ SAME, DIFFERENT, PARTLY, NOT_YET = "same", "different", "partly", "not yet"
 CGA: list[tuple[str, str, str, str]] = [
     # ---- operations ------------------------------------------------------------------------
     ("alignScopeToAxes", SAME, "", ""),
-    ("alignScopeToGeometry", PARTLY, "", "2D shapes (lots, faces); a solid's faces not yet"),
+    (
+        "alignScopeToGeometry",
+        SAME,
+        "",
+        "2D shapes, and solids by the planar faces comp(f) gives (not assets)",
+    ),
     ("center", SAME, "", ""),
     ("cleanupGeometry", SAME, "", ""),
     ("color", SAME, "", ""),

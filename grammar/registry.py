@@ -200,7 +200,8 @@ OPERATIONS: dict[str, Op] = {
             "alignScopeToGeometry",
             "transforms",
             _sig(Param("upAxis", UP_AXIS), Param("face", FACE_PICK), Param("edge", EDGE_PICK)),
-            "Turn the scope of a 2D shape to one of its edges, as CGA's alignScopeToGeometry: x "
+            "Turn the scope to an edge of one of the shape's faces (a 2D shape's own, a solid's "
+            "as comp(f) takes them), as CGA's alignScopeToGeometry: x "
             "along the edge (an index of the face's outline, `longest` or `world.lowest`), the "
             "face's normal as y (`yUp`) or z (`zUp`); the face is an index, `largest`, "
             "`world.lowest` or `any` (the face holding the edge chosen). The geometry stays "

@@ -88,8 +88,9 @@ def test_align_scope_to_geometry_yup_makes_the_normal_y():
     x, y, _ = _axes(result)
     assert np.allclose(y, [0, 0, -1], atol=1e-9)  # the front face looks to -z
     assert result.terminals.size[0][1] == pytest.approx(0.0)
-    with pytest.raises(bgr.BgrError, match="alignScopeToGeometry\\(\\) of a solid"):
-        _derive("Lot --> extrude(4) alignScopeToGeometry(yUp, 0, 0)")
+    # an asset or a round primitive has no faces to align to
+    with pytest.raises(bgr.BgrError, match="alignScopeToGeometry\\(\\) of a 'sphere'"):
+        _derive("terminal A\nLot --> i(sphere) alignScopeToGeometry(yUp, 0, 0) A")
 
 
 def test_rotate_scope_turns_the_scope_not_the_geometry():
@@ -190,3 +191,23 @@ def test_convexify_cuts_a_concave_outline_into_convex_faces():
     assert kept == 1
     _, box = parts("convexify()")  # a rectangle is convex already
     assert box == 1
+
+
+def test_align_scope_to_geometry_of_a_solid_uses_its_faces():
+    # CGA's roof-tile idiom on the roof itself: y along the largest slope's normal, x along
+    # that slope's lowest edge (the eave); the roof stays where it was
+    text = (
+        "terminal R\nLot --> extrude(6) comp(f) { top: Roof }\nRoof --> roof(gable, 30) ALIGN R\n"
+    )
+    lot = (10.0, 8.0)  # the ridge along x
+    turned = _derive(
+        text.replace("ALIGN", "alignScopeToGeometry(yUp, largest, world.lowest)"), lot=lot
+    )
+    plain = _derive(text.replace("ALIGN", ""), lot=lot)
+    _same_place(turned, plain)
+    axes = np.asarray(turned.terminals.axes[0])
+    assert abs(axes[0][1]) < 1e-9 and abs(abs(axes[0][0]) - 1) < 1e-9  # x along the eave
+    assert axes[1][1] == pytest.approx(np.cos(np.radians(30)))  # y the slope's normal
+    # zUp puts the normal on z instead; an edge picked by index works too
+    up_z = _derive(text.replace("ALIGN", "alignScopeToGeometry(zUp, 0, 0)"), lot=lot)
+    _same_place(up_z, plain)

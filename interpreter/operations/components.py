@@ -41,7 +41,8 @@ def faces_of(app, step, shape):
             raise runtime_error(
                 app.module,
                 step.pos,
-                f"comp(f) of a '{geom.name}' shape is not supported",
+                f"{'comp(f)' if step.name == 'comp' else step.name + '()'} of a "
+                f"'{geom.name}' shape is not supported",
                 "comp(f) works on extruded shapes, boxes, roofs, tapers and 2D shapes",
             )
         unit = app.engine.table.library.meshes[geom.mesh]

@@ -63,21 +63,24 @@ def align_scope_to_axes(app, shape, step, args) -> bool:
 def align_scope_to_geometry(app, shape, step, args) -> bool:
     up, face_pick, edge_pick = args[0], args[1], args[2]
     geom = shape.geom
-    if not isinstance(geom, Flat):
-        raise runtime_error(
-            app.module,
-            step.pos,
-            "alignScopeToGeometry() of a solid is not in bgr yet",
-            "align a 2D shape: a lot, or a face from comp(f)",
-        )
-    faces = flat_points(shape.origin, shape.axes, shape.size, geom.k, geom.polys)
-    rings = [ext for ext, _ in faces]
-    start, end = _edge(app, step, rings, face_pick, edge_pick)
+    if isinstance(geom, Flat):
+        faces = flat_points(shape.origin, shape.axes, shape.size, geom.k, geom.polys)
+        rings = [ext for ext, _ in faces]
+        normals = [tuple(shape.axes[geom.k])] * len(rings)
+    else:  # a solid: its planar faces (as comp(f) takes them), in the world
+        from .components import faces_of
+
+        solid_faces = faces_of(app, step, shape)
+        rings = [[shape.world(p) for p in face_rings[0]] for face_rings, _, _ in solid_faces]
+        normals = [tuple(shape.direction(nrm)) for _, nrm, _ in solid_faces]
+    start, end, face = _edge(app, step, rings, face_pick, edge_pick)
     along = [end[i] - start[i] for i in range(3)]
     if dot(along, along) < 1e-18:
         raise runtime_error(app.module, step.pos, "alignScopeToGeometry(): that edge has no length")
     x = tuple(normalise(along))
-    normal = tuple(shape.axes[geom.k])
+    normal = normals[face]
+    if abs(dot(x, normal)) > 1e-6:  # an edge off the face's plane (a solid's, picked by any)
+        raise runtime_error(app.module, step.pos, "alignScopeToGeometry(): that edge is not flat")
     if up == "yUp":
         frame = (x, normal, tuple(cross(x, normal)))
     else:
@@ -94,7 +97,8 @@ def _without(v, axis) -> list | None:
 
 
 def _edge(app, step, rings: list, face_pick, edge_pick):
-    """The (start, end) world points of the edge alignScopeToGeometry's arguments choose."""
+    """The (start, end) world points of the edge alignScopeToGeometry's arguments choose, and
+    the index of the face (ring) it belongs to."""
 
     def edges(ring):
         return [(ring[i], ring[(i + 1) % len(ring)]) for i in range(len(ring))]
@@ -106,15 +110,15 @@ def _edge(app, step, rings: list, face_pick, edge_pick):
         return (e[0][1] + e[1][1]) / 2
 
     if face_pick == "any":
-        candidates = [e for ring in rings for e in edges(ring)]
+        candidates = [(*e, k) for k, ring in enumerate(rings) for e in edges(ring)]
     else:
         if face_pick == "largest":
-            ring = max(rings, key=_area)
+            k = max(range(len(rings)), key=lambda i: _area(rings[i]))
         elif face_pick == "world.lowest":
-            ring = min(rings, key=lambda r: min(p[1] for p in r))
+            k = min(range(len(rings)), key=lambda i: min(p[1] for p in rings[i]))
         else:
-            ring = rings[_index(app, step, face_pick, len(rings), "face")]
-        candidates = edges(ring)
+            k = _index(app, step, face_pick, len(rings), "face")
+        candidates = [(*e, k) for e in edges(rings[k])]
         if edge_pick not in ("longest", "world.lowest"):
             return candidates[_index(app, step, edge_pick, len(candidates), "edge")]
     if edge_pick == "longest":
