@@ -55,6 +55,26 @@ def find(text: str, folder: Path) -> Path | None:
     return None
 
 
+def like(prefix: str, suffix: str, folder: Path, most: int = 64) -> list[str]:
+    """The CGA paths of the files that start with ``prefix`` and end with ``suffix`` in the
+    first folder around ``folder`` that holds any (a path computed as prefix + x + suffix)."""
+    head, _, start = prefix.replace("\\", "/").rpartition("/")
+    for root in _roots(folder):
+        where = root / head if head else root
+        if not head.strip("/") and head:
+            continue
+        if not where.is_dir():
+            continue
+        names = sorted(
+            f.name
+            for f in where.iterdir()
+            if f.is_file() and f.name.startswith(start) and f.name.lower().endswith(suffix.lower())
+        )
+        if names:
+            return [f"{head}/{name}" if head else name for name in names[:most]]
+    return []
+
+
 @dataclass
 class Assets:
     """The assets and textures one CGA file names, as the .bgr file in ``out_dir`` reaches them."""

@@ -36,7 +36,8 @@ def dispatch_insert(tr, t, meta, rest: list) -> list:
     value = tr.expr(t)
     tail = tr.steps(rest)
     choices: dict[str, n.Expr] = {}
-    for text in sorted(file_strings(tr, GEOMETRY_FILES, builtin=True)):
+    named = file_strings(tr, GEOMETRY_FILES, builtin=True) | set(_computed_files(tr, t))
+    for text in sorted(named):
         choices[text] = tr.assets.geometry(text, meta, tr.warn)
     kinds = {ops_key(g) for g in choices.values()} | {"cube"}
     if len(kinds) == 1:
@@ -84,6 +85,8 @@ def file_strings(tr, suffixes: tuple, builtin: bool = False) -> set[str]:
     out = set()
     for tok in tr.tree.scan_values(lambda v: isinstance(v, Token) and v.type == "STRING"):
         text = unquote(tok)
+        if not text.rsplit("/", 1)[-1].rsplit(".", 1)[0]:
+            continue  # ".obj": the end of a computed path, no file of its own
         if text.lower().endswith(suffixes) or (builtin and text.startswith("builtin:")):
             out.add(text)
     return out
@@ -91,3 +94,17 @@ def file_strings(tr, suffixes: tuple, builtin: bool = False) -> set[str]:
 
 def ops_key(e: n.Expr) -> str:
     return e.name if isinstance(e, n.Name) else repr(e)
+
+
+def _computed_files(tr, t) -> list[str]:
+    """The asset files a path written ``"prefix" + x + ".obj"`` can name: those beside the
+    CGA file that start and end so (a name built from an attr or a random choice)."""
+    from .files import like
+
+    if not (hasattr(t, "data") and t.data == "sum"):
+        return []
+    first, last = t.children[0], t.children[-1]
+    prefix, suffix = ops.literal_string(first), ops.literal_string(last)
+    if prefix is None or suffix is None or not suffix.lower().endswith(GEOMETRY_FILES):
+        return []
+    return like(prefix, suffix, tr.assets.folder)

@@ -453,3 +453,17 @@ def test_nil_in_the_middle_of_a_sequence_lets_the_rest_run(tmp_path):
     assert 'X --> report("c", 3) NIL' in text
     (lot,) = _derive(out).reports
     assert {k: v["sum"] for k, v in lot["reports"].items()} == {"a": 1, "b": 2}
+
+
+def test_an_asset_path_built_from_strings_picks_among_the_files_beside(tmp_path):
+    assets = tmp_path / "assets"
+    assets.mkdir()
+    tri = "v 0 0 0\nv 1 0 0\nv 1 1 0\nf 1 2 3\n"
+    (assets / "tree1.obj").write_text(tri)
+    (assets / "tree2.obj").write_text(tri + "v 0 1 0\nf 1 3 4\n")
+    out, result = _import(tmp_path, 'attr n = 1\nLot --> i("assets/tree" + n + ".obj") Tree.\n')
+    assert [w.message for w in result.warnings if "not found" in w.message] == []
+    grammar = bgr.load(out, allow_paths=[tmp_path])
+    for n, triangles in ((1, 1), (2, 2), (3, 12)):  # no tree3.obj: a box of the scope
+        derived = bgr.derive(grammar, lot=(4.0, 4.0), attrs={"n": n})
+        assert len(derived.mesh.faces) == triangles
