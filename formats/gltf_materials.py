@@ -16,9 +16,10 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from bgr.interpreter.surfaces import DEFAULTS
 from bgr.interpreter.terminals import TerminalTable
 
-from .materials import Materials, materials_of
+from .materials import Materials, materials_of, surface_text
 from .meshes import MeshPool, face_offsets
 from .texcoords import corner_tangents, corner_uvs
 
@@ -33,6 +34,7 @@ class MaterialIndex:
         self.numbers: dict[tuple, int] = {}
         self.names: list[str | None] = []
         self.rgb8: list[np.ndarray] = []
+        self.values: list[tuple[float, float, float]] = []  # opacity, metallic, roughness
         # per material: (colour map, normal map) image paths, None for none (texcoords.py)
         self.textures: list[tuple[str | None, str | None]] = []
 
@@ -43,11 +45,12 @@ class MaterialIndex:
         local = materials_of(table)
         number = np.empty(len(local), dtype=np.int64)
         for k, name in enumerate(local.names):
-            key = (name, *(int(c) for c in local.rgb8[k]))
+            key = (name, *(int(c) for c in local.rgb8[k]), local.surface(k))
             if key not in self.numbers:
                 self.numbers[key] = len(self.names)
                 self.names.append(name)
                 self.rgb8.append(local.rgb8[k])
+                self.values.append(local.surface(k))
                 self.textures.append((None, None))
             number[k] = self.numbers[key]
         local.index = number[local.index] if len(local.index) else local.index
@@ -70,11 +73,12 @@ class MaterialIndex:
             row = int(first[j])
             k = int(local.index[rows[row]])
             images = (paths[int(maps[row, 0])], paths[int(maps[row, 1])])
-            key = (self.names[k], *(int(c) for c in self.rgb8[k]), *images)
+            key = (self.names[k], *(int(c) for c in self.rgb8[k]), self.values[k], *images)
             if key not in self.numbers:
                 self.numbers[key] = len(self.names)
                 self.names.append(self.names[k])
                 self.rgb8.append(self.rgb8[k])
+                self.values.append(self.values[k])
                 self.textures.append(images)
             number[j] = self.numbers[key]
         local.index[rows] = number[inverse.reshape(-1)]
@@ -91,8 +95,10 @@ class MaterialIndex:
             label = hx if n is None else (n if per_name[n] == 1 else f"{n} {hx}")
             if self.textures[k] != (None, None):  # the image's file name tells them apart
                 label += " " + " ".join(p.rsplit("/", 1)[-1] for p in self.textures[k] if p)
+            if self.values[k] != DEFAULTS:
+                label += " " + surface_text(self.values[k])
             labels.append(label)
-        return Materials(np.zeros(0, np.int64), rgb8, list(self.names), labels)
+        return Materials(np.zeros(0, np.int64), rgb8, list(self.names), labels, list(self.values))
 
     def members(self, images: dict[str, int], alpha: dict[str, bool]) -> list[dict]:
         """The ``materials`` member: PBR, the colour in linear light, its maps as textures
@@ -102,15 +108,18 @@ class MaterialIndex:
             {
                 "name": mats.labels[k],
                 "pbrMetallicRoughness": {
-                    "baseColorFactor": mats.linear(k) + [1.0],
-                    "metallicFactor": 0.0,
-                    "roughnessFactor": 0.8,
+                    "baseColorFactor": mats.linear(k) + [mats.surface(k)[0]],
+                    "metallicFactor": mats.surface(k)[1],
+                    "roughnessFactor": mats.surface(k)[2],
                 },
                 "doubleSided": True,
                 "extras": {"color": mats.hex(k), "material": mats.names[k]},
             }
             for k in range(len(mats))
         ]
+        for k, material in enumerate(materials):
+            if mats.surface(k)[0] < 1.0:  # set(material.opacity, ...): seen through
+                material["alphaMode"] = "BLEND"
         for k, (color, normal) in enumerate(self.textures):
             if color is not None:
                 pbr: dict = materials[k]["pbrMetallicRoughness"]

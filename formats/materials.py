@@ -7,10 +7,11 @@ same colour share a material.
 from __future__ import annotations
 
 import functools
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
+from bgr.interpreter.surfaces import DEFAULTS, name_of, values_of
 from bgr.interpreter.terminals import TerminalTable
 
 from .meshes import srgb8
@@ -22,6 +23,11 @@ class Materials:
     rgb8: np.ndarray  # (K, 3) uint8 sRGB
     names: list[str | None]  # (K,) the material() name, or None
     labels: list[str]  # (K,) a display name, unique: the material name, else the colour hex
+    # (K,) (opacity, metallic, roughness) of each, set(material.*) values (interpreter/surfaces)
+    values: list[tuple[float, float, float]] = field(default_factory=list)
+
+    def surface(self, k: int) -> tuple[float, float, float]:
+        return self.values[k] if self.values else DEFAULTS
 
     def __len__(self) -> int:
         return len(self.names)
@@ -61,7 +67,9 @@ def materials_of(table: TerminalTable) -> Materials:
     rank[order] = np.arange(len(order))
     index = rank[inverse.reshape(-1)]
     id_names = {i: n for n, i in name_ids.items()}
-    names = [id_names[int(uniq[k] >> 24)] for k in order]
+    materials = [id_names[int(uniq[k] >> 24)] for k in order]  # names, or Surfaces
+    names = [name_of(m) for m in materials]
+    values = [values_of(m) for m in materials]
     rgb8 = rgb[first[order]] if len(order) else np.zeros((0, 3), dtype=np.uint8)
 
     labels: list[str] = []
@@ -70,5 +78,16 @@ def materials_of(table: TerminalTable) -> Materials:
         colours_per_name[n] = colours_per_name.get(n, 0) + 1
     for k, n in enumerate(names):
         hx = "#" + "".join(f"{int(c):02x}" for c in rgb8[k])
-        labels.append(hx if n is None else (n if colours_per_name[n] == 1 else f"{n} {hx}"))
-    return Materials(index=index.astype(np.int64), rgb8=rgb8, names=names, labels=labels)
+        label = hx if n is None else (n if colours_per_name[n] == 1 else f"{n} {hx}")
+        if values[k] != DEFAULTS:  # the same name and colour, other values: told apart
+            label += " " + surface_text(values[k])
+        labels.append(label)
+    return Materials(
+        index=index.astype(np.int64), rgb8=rgb8, names=names, labels=labels, values=values
+    )
+
+
+def surface_text(values: tuple[float, float, float]) -> str:
+    """``opacity 0.4 metallic 0 roughness 0.8``: the values a material label adds."""
+    names = ("opacity", "metallic", "roughness")
+    return " ".join(f"{k} {v:g}" for k, v in zip(names, values, strict=True))

@@ -39,6 +39,7 @@ from typing import BinaryIO
 
 import numpy as np
 
+from bgr.interpreter.surfaces import DEFAULTS
 from bgr.interpreter.terminals import TerminalTable
 
 from .gltf_materials import MaterialIndex
@@ -285,14 +286,17 @@ def mtl_text(
     lines = ["# bgr materials"]
     for k, name in enumerate(names):
         r, g, b = (c / 255.0 for c in mats.rgb8[k])
+        opacity, metallic, roughness = mats.surface(k)
         lines += [
             f"newmtl {name}",
             f"Kd {r:.6g} {g:.6g} {b:.6g}",
             "Ka 0 0 0",
             "Ks 0 0 0",
-            "d 1",
+            f"d {opacity:.6g}",
             "illum 1",
         ]
+        if (opacity, metallic, roughness) != DEFAULTS:  # set(material.*): the PBR extension's
+            lines += [f"Pm {metallic:.6g}", f"Pr {roughness:.6g}"]
         color, normal = maps[k] if maps else (None, None)
         if color is not None and files:
             lines.append(f"map_Kd {files[color]}")

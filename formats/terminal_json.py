@@ -15,6 +15,7 @@ import numpy as np
 
 from bgr.grammar.errors import BgrError
 from bgr.grammar.parser import no_gc
+from bgr.interpreter.surfaces import ATTRIBUTES, Surface, values_of
 from bgr.interpreter.terminals import TerminalTable, lot_tables
 
 from .meshes import srgb8
@@ -51,7 +52,7 @@ def terminal_dicts(table: TerminalTable) -> list[dict]:
         size = (table.size + 0.0).tolist()
         rgb = srgb8(table).astype(np.int64)  # rounded as terminals.color_hex rounds
         colours = [f"#{v:06x}" for v in ((rgb[:, 0] << 16) | (rgb[:, 1] << 8) | rgb[:, 2]).tolist()]
-        return [
+        rows = [
             {
                 "label": label,
                 "rule": rule,
@@ -76,6 +77,12 @@ def terminal_dicts(table: TerminalTable) -> list[dict]:
                 strict=True,
             )
         ]
+    for row in rows:  # set(material.opacity, ...) and the others: the name, and the values
+        material = row["material"]
+        if isinstance(material, Surface):
+            row["material"] = material.name
+            row["surface"] = dict(zip(ATTRIBUTES, values_of(material), strict=True))
+    return rows
 
 
 # what the terminal list says of each lot: its frame (the inverse modules read a face's side in

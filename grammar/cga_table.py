@@ -87,7 +87,8 @@ CGA: list[tuple[str, str, str, str]] = [
         "set",
         PARTLY,
         "",
-        "attrs; `set(material.name, v)` is `material(v)`; other shape attributes not yet",
+        "attrs; `trim.*`; `material.opacity`, `.metallic`, `.roughness`; `set(material.name, v)` "
+        "is `material(v)`; other shape attributes (specular, shininess...) not yet",
     ),  # fmt: skip
     (
         "setback",

@@ -73,8 +73,15 @@ UP_AXES = ("yUp", "zUp")
 CLEANUP_KINDS = ("all", "faces", "edges", "vertices")
 INNER_ALIGNMENTS = ("scope",)
 # CGA's shape attributes set() may change besides a file's attrs: whether trim planes cut
-# (bgr makes vertical ones only, so trim.horizontal changes nothing)
-SHAPE_ATTRIBUTES = ("trim.vertical", "trim.horizontal")
+# (bgr makes vertical ones only, so trim.horizontal changes nothing), and the material's
+# opacity, metallic and roughness (0..1: interpreter/surfaces.py)
+SHAPE_ATTRIBUTES = (
+    "trim.vertical",
+    "trim.horizontal",
+    "material.opacity",
+    "material.metallic",
+    "material.roughness",
+)
 # kinds that take a number or one of these words
 NUMBER_OR_WORD = {
     FACE_PICK: ("largest", "world.lowest", "any"),

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from ..expressions import runtime_error
 from ..occlusion import note
+from ..surfaces import renamed
 
 
 def _channel(app, step, value) -> float:
@@ -40,7 +41,7 @@ def color(app, shape, step, args) -> bool:
 
 
 def material(app, shape, step, args) -> bool:
-    shape.material = str(args[0])
+    shape.material = renamed(shape.material, str(args[0]))  # set(material.*) values stay
     return False
 
 

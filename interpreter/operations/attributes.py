@@ -13,6 +13,7 @@ from __future__ import annotations
 from bgr.grammar.registry import SHAPE_ATTRIBUTES
 
 from ..expressions import RuleRef, runtime_error
+from ..surfaces import with_value
 
 
 def set_attr(app, shape, step, args) -> bool:
@@ -24,6 +25,16 @@ def set_attr(app, shape, step, args) -> bool:
             f"set({name}, ...) takes a number, a string or true/false, not the rule "
             f"'{value.member}'",
         )
+    if name.startswith("material."):  # opacity, metallic, roughness: 0..1
+        whole = isinstance(value, (int, float)) and not isinstance(value, bool)
+        if not whole or not 0.0 <= value <= 1.0:
+            raise runtime_error(
+                app.module,
+                step.pos,
+                f"set({name}, ...) takes a number from 0 to 1, got {value!r}",
+            )
+        shape.material = with_value(shape.material, name.split(".", 1)[1], float(value))
+        return False
     if name in SHAPE_ATTRIBUTES:
         if not isinstance(value, bool):
             raise runtime_error(app.module, step.pos, f"set({name}, ...) takes true or false")
