@@ -344,7 +344,8 @@ class Translator:
                 'name it: import name : "file.cga"',
             )
             return
-        alias, target, bindings = str(t.children[0]), unquote(t.children[1]), t.children[2]
+        alias, target, args = str(t.children[0]), unquote(t.children[1]), t.children[2]
+        bindings = args.children[0] if args is not None else None
         found = self.resolve_import(target, t.meta)
         if found is None:
             self.imports[alias] = None
@@ -353,26 +354,33 @@ class Translator:
         name = self.fresh(alias, ("scope", "split", "comp", "stdlib"))
         self.imports[alias] = name
         items.append(n.Import(name, path=bgr_path, pos=pos(t.meta)))
-        for binding in bindings.children if bindings is not None else []:
+        listed = list(bindings.children) if bindings is not None else []
+        protected = {str(b.children[0]) for b in listed if len(b.children) == 1}
+        for binding in listed:
             self.bind(name, binding, their_attrs)
+        if args is not None and not listed:  # import x : "f.cga" (): every attr protected
+            return
+        # CGA propagates the importer's attrs to the imported file's of the same name, but
+        # those the import lists (protected, or given a value)
+        given = {str(b.children[0]) for b in listed}
+        for attr in their_attrs:
+            if attr in self.attrs and attr not in given | protected:
+                value = n.Name(self.attrs[attr])
+                target = n.Name(f"{name}.{their_attrs[attr]}")
+                self.bindings.append(n.Operation("set", [target, value]))
 
     def bind(self, alias: str, binding: Tree, their_attrs: dict) -> None:
         """An import's attribute binding ``(height = Eave_Ht)``: ``set(alias.height, Eave_Ht)``
-        when the start rule begins (``height`` alone binds the importer's attr of that name)."""
+        when the start rule begins; ``(height)`` alone protects the imported file's attr from
+        the importer's of that name (nothing to write)."""
         attr = str(binding.children[0])
         if attr not in their_attrs:
             self.warn(binding.meta, f"the imported file has no attr '{attr}'; binding left out")
             return
-        value = (
-            self.expr(binding.children[1])
-            if len(binding.children) > 1
-            else self.value(attr, binding.meta)
-        )
-        if value is None:
-            self.warn(binding.meta, f"'{attr}' is not an attr here; binding left out")
+        if len(binding.children) == 1:
             return
         target = n.Name(f"{alias}.{their_attrs[attr]}")
-        self.bindings.append(n.Operation("set", [target, value]))
+        self.bindings.append(n.Operation("set", [target, self.expr(binding.children[1])]))
 
     def func(self, t: Tree) -> n.Func:
         name, params = str(t.children[0]), _names(t.children[1])

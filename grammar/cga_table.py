@@ -180,7 +180,8 @@ CGA: list[tuple[str, str, str, str]] = [
         "import",
         DIFFERENT,
         'import "file.bgr" as name',
-        "then `name.Rule`; a binding `(attr = v)` is `set(name.attr, v)` (import-cga); "
+        "then `name.Rule`; a binding `(attr = v)` is `set(name.attr, v)`, an attr of the same "
+        "name in both files propagates as CGA's (import-cga); "
         "`name.Rule --> ...` overrides the imported rule, as CGA's",
     ),
     ("scope.sx, scope.sy, scope.sz", SAME, "scope.sx, scope.sy, scope.sz", ""),

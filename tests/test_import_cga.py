@@ -467,3 +467,29 @@ def test_an_asset_path_built_from_strings_picks_among_the_files_beside(tmp_path)
     for n, triangles in ((1, 1), (2, 2), (3, 12)):  # no tree3.obj: a box of the scope
         derived = bgr.derive(grammar, lot=(4.0, 4.0), attrs={"n": n})
         assert len(derived.mesh.faces) == triangles
+
+
+@pytest.mark.parametrize(
+    "args, height",
+    [
+        ("", 20.0),  # CGA propagates the importer's attr of the same name
+        ("(height)", 10.0),  # a listed name is protected
+        ("()", 10.0),  # empty brackets protect every attr
+        ("(height = 7)", 7.0),  # a value given to it
+        ("(floors)", 20.0),  # another attr listed: height still propagates
+    ],
+)
+def test_import_propagates_attrs_of_the_same_name(tmp_path, args, height):
+    rules = tmp_path / "rules"
+    rules.mkdir()
+    (rules / "imp.cga").write_text("attr height = 10\nattr floors = 2\nLot --> extrude(height)\n")
+    (rules / "main.cga").write_text(
+        f'import imp : "imp.cga" {args}\nattr height = 20\n@StartRule\nLot --> imp.Lot\n'
+    )
+    out = tmp_path / "out" / "main.bgr"
+    out.parent.mkdir()
+    result = translate_file(rules / "main.cga", out)
+    for path, text in result.outputs.items():
+        path.write_text(text, encoding="utf-8")
+    derived = _derive(out, lot=(4.0, 4.0))
+    assert derived.mesh.bounds[1][1] == pytest.approx(height)
