@@ -49,9 +49,16 @@ def measure_bgr(folder: Path, rule: str, lot: tuple[float, float]) -> dict:
         (lot_reports,) = derived.reports
         return {
             "triangles": int(len(derived.mesh.faces)),
-            "reports": {k: [v["count"], v["sum"]] for k, v in lot_reports["reports"].items()},
+            "reports": {
+                k: [v["count"], v.get("sum", 0.0)] for k, v in lot_reports["reports"].items()
+            },
             "untranslated": len(result.warnings),
         }
+
+
+def _shown(value) -> str:
+    """A report's number to one decimal; a string report's value as it is."""
+    return f"{value:.1f}" if isinstance(value, (int, float)) else repr(value)
 
 
 def main() -> None:
@@ -81,10 +88,10 @@ def main() -> None:
     keys = sorted(set(ours["reports"]) | set(theirs["reports"] if theirs else {}))
     for key in keys:
         mine = ours["reports"].get(key, [0, 0.0])
-        line = f"report {key!r}: bgr n={mine[0]} sum={mine[1]:.1f}"
+        line = f"report {key!r}: bgr n={mine[0]} sum={_shown(mine[1])}"
         if theirs:
             other = theirs["reports"].get(key, [0, 0.0])
-            line += f"; CityEngine n={other[0]:.0f} sum={other[1]:.1f}"
+            line += f"; CityEngine n={_shown(other[0])} sum={_shown(other[1])}"
         print(line)
 
 
