@@ -198,7 +198,8 @@ CGA: list[tuple[str, str, str, str]] = [
         DIFFERENT,
         'import "file.bgr" as base',
         "import-cga writes each style as a grammar that sets the attrs it redefines "
-        "(`set(base.attr, v)`) and runs the file's start rule",
+        "(`set(base.attr, v)`), overrides the rules it redefines (`base.Rule --> ...`) and "
+        "runs the file's start rule",
     ),
 ]
 # CGA's operations (the first part of the list), and those its reference has beyond the

@@ -40,6 +40,21 @@ def runtime_error(module, pos: n.Pos, message: str, hint: str | None = None) -> 
     )
 
 
+def _set_or_declared(values: dict, name: str, key: tuple) -> Compiled:
+    """An attr's value as the shape has it: the last set() of it on the shape's way
+    (``Shape.attrs``, by (module id, name)), else its value for the lot."""
+
+    def attr(ctx):
+        shape = ctx.shape
+        if shape is not None and shape.attrs:
+            for k, v in shape.attrs:
+                if k == key:
+                    return v
+        return values[name]
+
+    return attr
+
+
 class Context:
     """What an expression can see while a shape is being derived."""
 
@@ -238,17 +253,7 @@ class Compiler:
         if name in self.values:
             values = self.values
             if name in getattr(self.module, "settable", ()):  # set() may have changed it here
-                key = (id(self.module), name)
-
-                def attr(ctx):
-                    shape = ctx.shape
-                    if shape is not None and shape.attrs:
-                        for k, v in shape.attrs:
-                            if k == key:
-                                return v
-                    return values[name]
-
-                return attr
+                return _set_or_declared(values, name, (id(self.module), name))
             return lambda ctx: values[name]
         if name == "scope.sx":
             return lambda ctx: ctx.shape.size[0]
@@ -287,8 +292,10 @@ class Compiler:
             ref = RuleRef(module, member)
             return lambda ctx: ref
         alias, member = name.split(".", 1)
-        other = self.modules[id(self.module.imports[alias])]
-        values = other.values
+        imported = self.module.imports[alias]
+        values = self.modules[id(imported)].values
+        if member in getattr(imported, "settable", ()):  # set(alias.attr, v) may have changed it
+            return _set_or_declared(values, member, (id(imported), member))
         return lambda ctx: values[member]
 
     # ---- expressions -------------------------------------------------------------------

@@ -392,27 +392,33 @@ def test_primitive_cube_of_negative_size_extends_the_other_way(tmp_path):
     assert np.allclose(_derive(out).mesh.bounds, [[3, 0, 5], [5, 1, 8]])
 
 
-def test_a_style_becomes_a_grammar_that_sets_the_attrs_it_redefines(tmp_path):
+def test_a_style_becomes_a_grammar_that_sets_its_attrs_and_overrides_its_rules(tmp_path):
     out, result = _import(
         tmp_path,
         """attr wall = "#888888"
 attr h = 6
 Lot --> extrude(h) color(wall) Mass
+Mass --> Block.
 style Red
 attr wall = "#cc0000"
 attr h = h * 2
-Lot --> NIL
+Mass --> case h > 10 : s('1, '0.5, '1) Half. else : NIL
+Tower --> NIL
 """,
     )
     styled = out.with_name("rules.Red.bgr")
     assert styled.is_file()
     text = styled.read_text()
     assert 'set(base.wall, "#cc0000")' in text and "set(base.h, base.h * 2)" in text
-    assert [w.line for w in result.warnings] == [7]  # a rule in a style: left out, said where
+    assert "base.Mass --> case base.h > 10:" in text  # the style's rule overrides the file's
+    # a rule the file does not have is left out, said where
+    assert [w.line for w in result.warnings] == [9]
     plain, red = _derive(out), _derive(styled)
+    assert list(plain.terminals.label) == ["Block"]
     assert np.allclose(plain.terminals.color[0], [0x88 / 255] * 3, atol=1e-3)
+    assert list(red.terminals.label) == ["Half"]
     assert np.allclose(red.terminals.color[0], [0xCC / 255, 0, 0], atol=1e-3)
-    assert red.terminals.size[0][1] == pytest.approx(12.0)
+    assert red.terminals.size[0][1] == pytest.approx(6.0)  # 12 m, halved by the style's Mass
 
 
 def test_same_distance_setbacks_shapes_and_edges_translate(tmp_path):
