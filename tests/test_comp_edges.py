@@ -158,3 +158,16 @@ def test_selectors_of_each_kind_check():
         "| edge(0): A }\nB --> comp(v) { border: A | vertex(1): A | nutant: A }\n"
         "C --> comp(f) { nutant: A | face(0): A }\nterminal A\n"
     )
+
+
+def test_an_edge_extrudes_into_a_wall_along_it():
+    # a fence along a lot's outline: each edge's y is the lot's normal, so the walls stand up
+    src = "Lot --> comp(e) { all: extrude(1.5) Fence }\nterminal Fence\n"
+    fences = rows(src)
+    assert len(fences) == 4
+    assert sorted(round(t["size"][0], 6) for t in fences) == [6, 6, 10, 10]
+    for t in fences:
+        assert t["size"][1] == pytest.approx(1.5) and t["geometry"] == "polygon"
+        assert abs(t["axes"][1][1] - 1) < 1e-9  # up
+    result = bgr.derive(bgr.load(src), lot=(10, 6))
+    assert result.mesh.area == pytest.approx(2 * (10 + 6) * 1.5)

@@ -454,7 +454,15 @@ def extrude(app, shape, step, args) -> bool:
     given = len(step.args)  # extrude(height) or extrude(direction, height)
     direction = args[0] if given == 2 else "face.normal"
     height = _signed_height(app, step, args[given - 1])
-    if not isinstance(shape.geom, Flat) and direction == "face.normal":
+    geom = shape.geom
+    if isinstance(geom, Solid) and geom.name == "edge" and direction == "face.normal":
+        # an edge from comp(e): a wall along it, up its y (the mean normal of its faces)
+        if height < 0:
+            shape.origin = [shape.origin[i] + height * shape.axes[1][i] for i in range(3)]
+        shape.size = [shape.size[0], abs(height), 0.0]
+        shape.geom = Flat(2, RECT)
+        return False
+    if not isinstance(geom, Flat) and direction == "face.normal":
         # a solid: each face along its own normal, as CGA extrudes every face
         faces = [(rings, nrm) for rings, nrm, _ in faces_of(app, step, shape)]
         extrude_faces(app, shape, faces, height)
