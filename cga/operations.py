@@ -130,10 +130,12 @@ def operation(tr: Translator, name: str, args: list, block, meta, rest: list) ->
         distance = tr.expr(_same_distance(args[0]))
         return _with_block(tr, "setback", [distance], tr.block(block, "setback"), meta), True
     if name in ("innerRectangle", "innerRect") and block is not None:
-        if not args or _word(args[0]) != "scope":
-            tr.warn(meta, "innerRectangle() along the scope's axes only in bgr (scope)")
+        alignment = _word(args[0]) if args else "scope"
+        if alignment not in ("scope", "edge"):
+            tr.warn(meta, f"innerRectangle({alignment}) is read as innerRectangle(scope)")
+            alignment = "scope"
         body = tr.block(block, "innerRectangle")
-        return _with_block(tr, "innerRectangle", [n.Name("scope")], body, meta), True
+        return _with_block(tr, "innerRectangle", [n.Name(alignment)], body, meta), True
     if name == "setback":
         tr.warn(
             meta,

@@ -49,9 +49,9 @@ CGA: list[tuple[str, str, str, str]] = [
     ("i", SAME, "", 'a file path is declared first: `asset x = "x.obj"`, then `i(x)`'),
     (
         "innerRectangle",
-        PARTLY,
+        SAME,
         "",
-        "along the scope's axes (scope); edge alignment not yet; `innerRect` in older releases",
+        "`scope` and `edge` alignments; `innerRect` in older releases",
     ),
     ("insertAlongUV", NOT_YET, "", ""),
     ("label", SAME, "", ""),

@@ -31,7 +31,7 @@ NORMALIZE_MODE = "normalize mode"  # uv | uvUniform | u | v
 NORMALIZE_TYPE = "normalize type"  # separatePerFace | collectiveAllFaces
 UP_AXIS = "up axis"  # yUp | zUp (alignScopeToGeometry)
 CLEANUP_KIND = "components"  # all | faces | edges | vertices (cleanupGeometry)
-INNER_ALIGNMENT = "alignment"  # scope (innerRectangle)
+INNER_ALIGNMENT = "alignment"  # scope | edge (innerRectangle)
 # a number, or one of a few bare words (alignScopeToGeometry's face and edge)
 FACE_PICK = "face index or selector"  # a number | largest | world.lowest | any
 EDGE_PICK = "edge index or selector"  # a number | longest | world.lowest
@@ -71,7 +71,7 @@ NORMALIZE_MODES = ("uv", "uvUniform", "u", "v")
 NORMALIZE_TYPES = ("separatePerFace", "collectiveAllFaces")
 UP_AXES = ("yUp", "zUp")
 CLEANUP_KINDS = ("all", "faces", "edges", "vertices")
-INNER_ALIGNMENTS = ("scope",)
+INNER_ALIGNMENTS = ("scope", "edge")
 # CGA's shape attributes set() may change besides a file's attrs: whether trim planes cut
 # (bgr makes vertical ones only, so trim.horizontal changes nothing), and the material's
 # opacity, metallic and roughness (0..1: interpreter/surfaces.py)
@@ -295,9 +295,11 @@ OPERATIONS: dict[str, Op] = {
             "innerRectangle",
             "components",
             _sig(Param("alignment", INNER_ALIGNMENT)),
-            "The largest rectangle along the scope's axes inside a 2D shape (`shape`) and the "
-            "rest (`remainder`), as CGA's innerRectangle(scope): exact for outlines whose sides "
-            "run along the scope, to 1/64 of it for others.",
+            "The largest rectangle inside a 2D shape (`shape`) and the rest (`remainder`), as "
+            "CGA's innerRectangle: `scope`, its sides along the scope's axes (exact for outlines "
+            "whose sides run along the scope, to 1/64 of it for others); `edge`, a side along "
+            "one of the outline's edges (those longer than a quarter of their ring's longest), "
+            "the scope kept.",
             "innerRectangle(scope) { shape: Building | remainder: Yard }",
             block="innerRectangle",
         ),

@@ -227,3 +227,32 @@ def test_a_face_turned_into_a_mesh_still_comes_apart():
     )
     result = bgr.derive(bgr.load(src), lot=(10, 8))
     assert len(result.terminals.label) == 6
+
+
+def test_inner_rectangle_along_an_edge_finds_a_turned_rectangle():
+    # CGA's innerRectangle(edge): a 10 x 6 rectangle turned 30 degrees in its scope is its own
+    # largest inner rectangle along its edges; along the scope's axes it is much less
+    c, s = np.cos(np.radians(30)), np.sin(np.radians(30))
+    pts = [(0, 0), (10 * c, 10 * s), (10 * c - 6 * s, 10 * s + 6 * c), (-6 * s, 6 * c)]
+    corners = ", ".join(f"{x + 3:.9f}, {z:.9f}" for x, z in pts)
+    text = (
+        f"terminal In, Out\nLot --> polygon({corners}) innerRectangle(ALIGN) "
+        "{ shape: In | remainder: Out }\n"
+    )
+    edge = bgr.derive(bgr.load(text.replace("ALIGN", "edge")), lot=(20.0, 20.0))
+    scope = bgr.derive(bgr.load(text.replace("ALIGN", "scope")), lot=(20.0, 20.0))
+
+    def area(result, label):
+        total = 0.0
+        for row, name in enumerate(result.terminals.label):
+            if name == label:
+                mesh = result.terminals.library.meshes[result.terminals.mesh[row]]
+                pts = world_vertices(result.terminals, np.array([row]), mesh)[0]
+                total += trimesh.Trimesh(pts, mesh.faces, process=False).area
+        return total
+
+    assert area(edge, "In") == pytest.approx(60, rel=1e-6)
+    assert area(edge, "Out") == pytest.approx(0, abs=1e-6)
+    assert 20 < area(scope, "In") < 50
+    # the scope keeps its axes, as CGA's: the piece is a turned rectangle in it
+    assert np.allclose(edge.terminals.axes[0], np.eye(3))

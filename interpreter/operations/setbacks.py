@@ -76,9 +76,12 @@ def _piece(app, shape, step, entry, metric_polys, p: int, q: int, k: int) -> Non
 
 
 def inner_rectangle(app, shape, step, args) -> bool:
-    """innerRectangle(scope) { shape: A | remainder: B }: the largest rectangle along the scope's
-    axes inside a 2D shape, and the rest (interpreter/geometry/inner_rectangle.py)."""
-    from ..geometry.inner_rectangle import inner_rectangle as largest
+    """innerRectangle(scope | edge) { shape: A | remainder: B }: the largest rectangle inside a
+    2D shape along the scope's axes or one of its edges, and the rest
+    (interpreter/geometry/inner_rectangle.py)."""
+    from ..geometry.inner_rectangle import inner_rectangle, inner_rectangle_edge
+
+    largest = inner_rectangle_edge if args[0] == "edge" else inner_rectangle
 
     geom = shape.geom
     if not isinstance(geom, Flat):
