@@ -104,7 +104,14 @@ CGA: list[tuple[str, str, str, str]] = [
     ("shapeO", SAME, "", ""),
     ("shapeU", SAME, "", ""),
     ("softenNormals", NOT_YET, "", ""),
-    ("split", SAME, "", "absolute, `'` relative and `~` floating sizes, `{ ... }*` repeats"),
+    (
+        "split",
+        PARTLY,
+        "",
+        "absolute, `'` relative and `~` floating sizes, `{ ... }*` repeats; a piece keeps the "
+        "slab's scope (CGA's `noAdjust`): the default `adjust`, a scope fitted to the piece's "
+        "geometry, not yet",
+    ),
     ("splitArea", NOT_YET, "", ""),
     ("t", SAME, "", ""),
     ("taper", SAME, "", ""),
