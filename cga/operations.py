@@ -254,9 +254,14 @@ def split(tr: Translator, args: list, block: Tree, meta) -> list:
     if axis not in ("x", "y", "z"):
         tr.warn(meta, "split() of this kind is not in bgr yet; its shape is dropped (NIL)")
         return [n.Nil(pos=pos(meta))]
-    if len(args) > 1:
-        tr.warn(meta, "split()'s adjust/unitSpace arguments are left out")
-    return _with_block(tr, "split", [n.Name(axis)], tr.block(block, "split"), meta)
+    # CGA fits each piece's scope to its geometry unless told noAdjust; bgr's split keeps the
+    # slab's unless told adjust
+    mode = _word(args[1]) if len(args) > 1 else "adjust"
+    if mode not in ("adjust", "noAdjust") or len(args) > 2:
+        tr.warn(meta, "split()'s unitSpace/uvSpace arguments are left out")
+        mode = "adjust" if mode not in ("adjust", "noAdjust") else mode
+    words = [n.Name(axis)] + ([n.Name("adjust")] if mode == "adjust" else [])
+    return _with_block(tr, "split", words, tr.block(block, "split"), meta)
 
 
 def comp(tr: Translator, args: list, block: Tree, meta) -> list:

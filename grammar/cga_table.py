@@ -108,9 +108,9 @@ CGA: list[tuple[str, str, str, str]] = [
         "split",
         PARTLY,
         "",
-        "absolute, `'` relative and `~` floating sizes, `{ ... }*` repeats; a piece keeps the "
-        "slab's scope (CGA's `noAdjust`): the default `adjust`, a scope fitted to the piece's "
-        "geometry, not yet",
+        "absolute, `'` relative and `~` floating sizes, `{ ... }*` repeats, `adjust` and "
+        "`noAdjust`: bgr's default is `noAdjust` (import-cga writes CGA's default, `adjust`); "
+        "`unitSpace`/`uvSpace` not yet",
     ),
     ("splitArea", NOT_YET, "", ""),
     ("t", SAME, "", ""),

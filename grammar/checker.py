@@ -59,6 +59,8 @@ from .registry import (
     SETBACK_SELECTORS,
     SHAPE_ATTRIBUTES,
     SIZE,
+    SPLIT_ADJUST,
+    SPLIT_ADJUSTS,
     STRING,
     TEX_SIZE,
     UP_AXES,
@@ -84,6 +86,7 @@ _SYMBOL_KINDS = {
     UP_AXIS: UP_AXES,
     CLEANUP_KIND: CLEANUP_KINDS,
     INNER_ALIGNMENT: INNER_ALIGNMENTS,
+    SPLIT_ADJUST: SPLIT_ADJUSTS,
 }
 _TEXTURE_OPS = ("texture", "normalMap")
 _RESERVED_ALIASES = {"scope", "split", "comp", "stdlib", "geometry"}

@@ -32,6 +32,7 @@ NORMALIZE_TYPE = "normalize type"  # separatePerFace | collectiveAllFaces
 UP_AXIS = "up axis"  # yUp | zUp (alignScopeToGeometry)
 CLEANUP_KIND = "components"  # all | faces | edges | vertices (cleanupGeometry)
 INNER_ALIGNMENT = "alignment"  # scope | edge (innerRectangle)
+SPLIT_ADJUST = "adjustment"  # noAdjust | adjust (split)
 # a number, or one of a few bare words (alignScopeToGeometry's face and edge)
 FACE_PICK = "face index or selector"  # a number | largest | world.lowest | any
 EDGE_PICK = "edge index or selector"  # a number | longest | world.lowest
@@ -72,6 +73,7 @@ NORMALIZE_TYPES = ("separatePerFace", "collectiveAllFaces")
 UP_AXES = ("yUp", "zUp")
 CLEANUP_KINDS = ("all", "faces", "edges", "vertices")
 INNER_ALIGNMENTS = ("scope", "edge")
+SPLIT_ADJUSTS = ("noAdjust", "adjust")
 # CGA's shape attributes set() may change besides a file's attrs: whether trim planes cut
 # (bgr makes vertical ones only, so trim.horizontal changes nothing), and the material's
 # opacity, metallic and roughness (0..1: interpreter/surfaces.py)
@@ -252,9 +254,11 @@ OPERATIONS: dict[str, Op] = {
         Op(
             "split",
             "splits",
-            _sig(Param("axis", AXIS)),
+            _sig(Param("axis", AXIS), Param("adjustment", SPLIT_ADJUST, "noAdjust")),
             "Cut the scope along an axis into pieces of absolute (`3`), relative (`'0.25`) and "
-            "floating (`~3`) sizes; `{ ... }*` repeats.",
+            "floating (`~3`) sizes; `{ ... }*` repeats. Each piece keeps the slab's scope "
+            "(`noAdjust`, the default), or with `adjust` (CGA's default) a scope fitted to the "
+            "part of the geometry it holds.",
             "split(x) { 1: Edge | { ~2: Window }* | 1: Edge }",
             block="split",
         ),

@@ -36,6 +36,7 @@ from bgr.grammar.registry import (
     PROJECTION_AXES,
     ROOF_KIND,
     SIZE,
+    SPLIT_ADJUST,
     TEX_SIZE,
     UP_AXIS,
 )
@@ -78,6 +79,7 @@ SYMBOL_KINDS = {
     UP_AXIS,
     CLEANUP_KIND,
     INNER_ALIGNMENT,
+    SPLIT_ADJUST,
 }
 _NUMERIC_KINDS = {
     NUMBER,

@@ -165,3 +165,19 @@ def test_nested_repeats_are_counted_too():
     src = "Lot --> split(x) { { 1: split(z) { 0.01: T }* }* }\nterminal T\n"
     with pytest.raises(bgr.BgrError, match="would make"):
         bgr.derive(bgr.load(src), lot=(1000, 1000), max_shapes=5000)
+
+
+def test_split_adjust_fits_each_piece_to_its_geometry():
+    # CGA's default split adjusts each piece's scope to the geometry it holds: the upper half
+    # of a triangle is as wide as the triangle is there; noAdjust (bgr's default) keeps the slab
+    src = "terminal P\nLot --> polygon(0, 0, 10, 0, 5, 10) split(z MODE) { ~5: P }*\n"
+    fitted = bgr.derive(bgr.load(src.replace(" MODE", ", adjust")), lot=(10, 10)).terminals
+    plain = bgr.derive(bgr.load(src.replace(" MODE", "")), lot=(10, 10)).terminals
+    assert [list(map(float, o)) for o in fitted.origin] == [[0, 0, 0], [2.5, 0, 5]]
+    assert [list(map(float, s)) for s in fitted.size] == [[10, 0, 5], [5, 0, 5]]
+    assert [list(map(float, s)) for s in plain.size] == [[10, 0, 5], [10, 0, 5]]
+    # a roof's slabs too: the hip roof's end slab is fitted to what it holds of the roof
+    roof = "terminal R\nLot --> roof(hip, 45) split(x, adjust) { ~2: R }*\n"
+    slabs = bgr.derive(bgr.load(roof), lot=(12, 8)).terminals
+    heights = [round(float(s[1]), 6) for s in slabs.size]
+    assert heights[0] == pytest.approx(2.0) and max(heights) == pytest.approx(4.0)

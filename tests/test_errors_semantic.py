@@ -260,7 +260,7 @@ CASES = [
         1,
         9,
         "operation 'split' needs its arguments",
-        "split(axis)",
+        "split(axis, adjustment)",
         id="split-without-args",
     ),
     pytest.param(

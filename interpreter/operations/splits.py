@@ -9,11 +9,14 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
+
 from bgr.grammar import nodes as n
 
 from ..expressions import runtime_error
 from ..geometry.meshes import PLANE_AXES
-from ..geometry.polygons import RECT, clip, renormalise
+from ..geometry.polygons import RECT, clip, is_unit_square, metric, renormalise
+from ..geometry.polygons import normalise as normalise_polys
 from ..geometry.slicing import slab
 from ..limits import format_bytes
 from ..shapes import Flat, Prism, Solid
@@ -110,8 +113,42 @@ def _clip_solid(app, geom: Solid, axis: int, lo: float, hi: float):
 _MISSING = object()
 
 
+def _fit(app, piece) -> None:
+    """split(axis, adjust): the piece's scope fitted to the geometry it holds, as CGA's default
+    split does (a row of a triangle as wide as the triangle is there)."""
+    geom = piece.geom
+    if isinstance(geom, (Flat, Prism)):
+        if geom.polys == RECT:
+            return
+        p, q = PLANE_AXES[geom.k]
+        unit, (x0, y0, w, h) = normalise_polys(metric(geom.polys, piece.size[p], piece.size[q]))
+        if w <= 0 or h <= 0:
+            return
+        move = [0.0, 0.0, 0.0]
+        move[p], move[q] = x0, y0
+        piece.origin = piece.world(move)
+        piece.size[p], piece.size[q] = w, h
+        piece.geom = type(geom)(geom.k, RECT if is_unit_square(unit) else unit, geom.name)
+        return
+    library = app.engine.table.library
+    mesh = library.meshes[geom.mesh]
+    if not len(mesh.faces):
+        return
+    used = mesh.vertices[np.unique(mesh.faces)]
+    low, high = used.min(axis=0), used.max(axis=0)
+    if np.allclose(low, 0.0, atol=1e-9) and np.allclose(high, 1.0, atol=1e-9):
+        return
+    span = np.where(high - low > 1e-12, high - low, 1.0)
+    verts = (mesh.vertices - low) / span
+    fitted = UnitMesh(mesh.name, verts, mesh.faces, mesh.uv, mesh.image)
+    piece.origin = piece.world(tuple(float(low[i] * piece.size[i]) for i in range(3)))
+    piece.size = [float(piece.size[i] * (high[i] - low[i])) for i in range(3)]
+    piece.geom = Solid(library.add(fitted), geom.name)
+
+
 def split(app, shape, step, args) -> bool:
     axis = "xyz".index(args[0])
+    adjust = len(step.args) > 1 and args[1] == "adjust"
     length = shape.size[axis]
     entries = step.block.entries
     sizes = app.engine.constant_sizes.get(id(entries))  # most splits: numbers in the grammar
@@ -174,6 +211,8 @@ def split(app, shape, step, args) -> bool:
         piece.origin = [ox + at * dx, oy + at * dy, oz + at * dz]
         piece.size[axis] = p.size
         piece.geom = geom
+        if adjust and not uncut:
+            _fit(app, piece)
         pieces.append((piece, p.payload))
     total = len(pieces)
     for index, (piece, entry) in enumerate(pieces):
