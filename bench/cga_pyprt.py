@@ -56,6 +56,18 @@ def measure_bgr(folder: Path, rule: str, lot: tuple[float, float]) -> dict:
         }
 
 
+def run_pyprt(python: str, script: str, rpk: str, lot: tuple[float, float]) -> dict:
+    """What ``script`` prints last (JSON) when run by ``python`` (a separate environment with
+    PyPRT) on the package and a W x D lot: CityEngine's own measurements."""
+    done = subprocess.run(
+        [python, "-c", script, rpk, str(lot[0]), str(lot[1])],
+        capture_output=True,
+        text=True,
+        check=True,
+    )
+    return json.loads(done.stdout.strip().splitlines()[-1])
+
+
 def _shown(value) -> str:
     """A report's number to one decimal; a string report's value as it is."""
     return f"{value:.1f}" if isinstance(value, (int, float)) else repr(value)
@@ -71,15 +83,7 @@ def main() -> None:
     args = ap.parse_args()
     w, d = (float(v) for v in args.lot.split(","))
     ours = measure_bgr(args.folder, args.rule, (w, d))
-    theirs = None
-    if args.pyprt:
-        done = subprocess.run(
-            [args.pyprt, "-c", PYPRT, args.rpk, str(w), str(d)],
-            capture_output=True,
-            text=True,
-            check=True,
-        )
-        theirs = json.loads(done.stdout.strip().splitlines()[-1])
+    theirs = run_pyprt(args.pyprt, PYPRT, args.rpk, (w, d)) if args.pyprt else None
     print(f"constructs not translated: {ours['untranslated']}")
     line = f"triangles: bgr {ours['triangles']:,}"
     if theirs:

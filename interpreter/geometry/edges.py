@@ -64,23 +64,24 @@ def _sides(faces):
                     yield index, a, b
 
 
-def edges(faces) -> list[Edge]:
-    """The distinct edges of the faces, in the order the faces first use them."""
-    order: list[tuple] = []
+def _gathered(faces, key_of) -> dict[tuple, list]:
+    """[first side's start, its end, the faces that have it] by ``key_of(start, end)``, in the
+    order the faces first use each key (dicts keep it)."""
     found: dict[tuple, list] = {}
     for index, a, b in _sides(faces):
-        key = tuple(sorted((_key(a), _key(b))))
-        entry = found.get(key)
-        if entry is None:
-            found[key] = [a, b, [index]]
-            order.append(key)
-        elif index not in entry[2]:
+        entry = found.setdefault(key_of(a, b), [a, b, []])
+        if index not in entry[2]:
             entry[2].append(index)
+    return found
+
+
+def edges(faces) -> list[Edge]:
+    """The distinct edges of the faces, in the order the faces first use them."""
+    found = _gathered(faces, lambda a, b: tuple(sorted((_key(a), _key(b)))))
     normals = [np.asarray(nrm, dtype=float) for _rings, nrm, *_ in faces]
     centres = [np.mean(np.asarray(rings[0], dtype=float), axis=0) for rings, *_ in faces]
     out = []
-    for key in order:
-        a, b, owners = found[key]
+    for a, b, owners in found.values():
         mean = _unit(sum(normals[i] for i in owners), normals[owners[0]])
         roof = _roof_kind(np.asarray(a, float), np.asarray(b, float), owners, normals, centres)
         out.append(Edge(tuple(a), tuple(b), tuple(mean.tolist()), tuple(owners), roof))
@@ -115,20 +116,10 @@ def vertices(faces) -> list[Vertex]:
     for edge in edges(faces):
         if len(edge.faces) == 1:
             border_keys.update((_key(edge.start), _key(edge.end)))
-    order: list[tuple] = []
-    found: dict[tuple, list] = {}
-    for index, a, b in _sides(faces):
-        key = _key(a)
-        entry = found.get(key)
-        if entry is None:
-            found[key] = [a, b, [index]]
-            order.append(key)
-        elif index not in entry[2]:
-            entry[2].append(index)
+    found = _gathered(faces, lambda a, b: _key(a))
     normals = [np.asarray(nrm, dtype=float) for _rings, nrm, *_ in faces]
     out = []
-    for key in order:
-        point, toward, owners = found[key]
+    for key, (point, toward, owners) in found.items():
         mean = _unit(sum(normals[i] for i in owners), normals[owners[0]])
         out.append(Vertex(tuple(point), tuple(mean.tolist()), tuple(toward), key in border_keys))
     return out
