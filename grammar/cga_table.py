@@ -121,10 +121,10 @@ CGA: list[tuple[str, str, str, str]] = [
     ("translateUV", SAME, "", ""),
     (
         "trim",
-        PARTLY,
+        SAME,
         "set(trim.vertical, true)",
-        "vertical trim planes from comp(f) cut what i() inserts and the trim() operation cuts, "
-        "once turned on (import-cga does); horizontal planes not yet",
+        "vertical and horizontal trim planes from comp(f) cut what i() inserts and what the "
+        "trim() operation cuts, once turned on (import-cga turns vertical ones on)",
     ),
     # ---- functions -------------------------------------------------------------------------
     ("abs", SAME, "", ""),

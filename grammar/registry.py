@@ -74,8 +74,8 @@ UP_AXES = ("yUp", "zUp")
 CLEANUP_KINDS = ("all", "faces", "edges", "vertices")
 INNER_ALIGNMENTS = ("scope", "edge")
 SPLIT_ADJUSTS = ("noAdjust", "adjust")
-# CGA's shape attributes set() may change besides a file's attrs: whether trim planes cut
-# (bgr makes vertical ones only, so trim.horizontal changes nothing), and the material's
+# CGA's shape attributes set() may change besides a file's attrs: whether vertical and
+# horizontal trim planes cut (operations/trims.py), and the material's
 # opacity, metallic and roughness (0..1: interpreter/surfaces.py)
 SHAPE_ATTRIBUTES = (
     "trim.vertical",

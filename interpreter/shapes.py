@@ -91,10 +91,9 @@ class Shape:
         # attrs set() on this shape or an ancestor: ((id(module), name), value) pairs sorted by
         # key, a tuple so that it can be part of a reuse key; None: none (operations/attributes)
         self.attrs: tuple | None = None
-        # CGA's trim planes: ((normal, c), ...) in world coordinates, the kept side where
-        # normal . point >= c; a comp(f) face gets one at each vertical edge (operations/trims).
-        # None: trimming is off (the default; set(trim.vertical, true) turns it on)
-        self.trims: tuple | None = None
+        # CGA's trim planes and whether its vertical and horizontal ones cut (operations/trims:
+        # a Trims); None: trimming is off (the default; set(trim.vertical, true) turns it on)
+        self.trims = None
 
     def copy(self) -> Shape:
         # slot by slot, not through __init__: a derivation copies shapes millions of times

@@ -106,3 +106,24 @@ def test_the_trim_operation_cuts_the_shapes_own_geometry():
     (lot,) = bgr.derive(grammar, lot=(10, 8), attrs={"on": False}).reports
     got = {k: v["sum"] for k, v in lot["reports"].items()}
     assert got["after"] == pytest.approx(12 * 6)
+
+
+@pytest.mark.parametrize("horizontal", [True, False])
+def test_horizontal_planes_cut_a_hip_roofs_tiles_at_the_hips(horizontal):
+    # CGA's trim.horizontal (off by default): comp(f) of a roof gives each slope planes at the
+    # edges it shares with the others, and those rising less than 40 degrees (the hips of a
+    # 30-degree roof, its ridge) are horizontal ones; with them on, tiles inserted over the
+    # whole width of each row (a split's pieces keep the slab's scope) are cut at the hips
+    switch = "set(trim.horizontal, true) " if horizontal else ""
+    src = (
+        "Lot --> set(trim.vertical, true) extrude(5) comp(f) { top: Roof }\n"
+        'Roof --> roof(hip, 30) [ report("roof", geometry.area()) ] comp(f) { aslant: Plane }\n'
+        f"Plane --> {switch}split(y) {{ ~1: split(x) {{ ~1: s('1, '1, 0.05) i(cube) "
+        'report("tiles", geometry.area(back)) B }* }*\nterminal B\n'
+    )
+    (lot,) = bgr.derive(bgr.load(src), lot=(10, 8)).reports
+    got = {k: v["sum"] for k, v in lot["reports"].items()}
+    if horizontal:  # the tiles' outer faces cover the slopes (cut a little wider, 5 cm out)
+        assert got["tiles"] == pytest.approx(got["roof"], rel=0.03)
+    else:  # the end slopes' and the sides' rows keep their full width
+        assert got["tiles"] > got["roof"] * 1.3

@@ -14,6 +14,7 @@ from bgr.grammar.registry import SHAPE_ATTRIBUTES
 
 from ..expressions import RuleRef, runtime_error
 from ..surfaces import with_value
+from .trims import switched
 
 
 def set_attr(app, shape, step, args) -> bool:
@@ -38,11 +39,8 @@ def set_attr(app, shape, step, args) -> bool:
     if name in SHAPE_ATTRIBUTES:
         if not isinstance(value, bool):
             raise runtime_error(app.module, step.pos, f"set({name}, ...) takes true or false")
-        if name == "trim.vertical":
-            if not value:
-                shape.trims = None  # off for the shape and what it derives
-            elif shape.trims is None:
-                shape.trims = ()  # on: the next comp(f) of a solid makes planes
+        # on: the next comp(f) of a solid makes planes; both off: none carried any more
+        shape.trims = switched(shape.trims, name.split(".", 1)[1], value)
         return False
     module, member = app.module.lookup_module(name)  # an imported file's attr: alias.name
     key = (id(module), member)

@@ -3,11 +3,13 @@
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 
 import numpy as np
 import shapely
 
 from ..expressions import runtime_error
+from ..geometry.edges import edges
 from ..geometry.frames import WORLD_UP, extrusion_axes, planar_faces, reframe_flat
 from ..geometry.meshes import PLANE_AXES
 from ..geometry.polygons import (
@@ -26,7 +28,7 @@ from ..shapes import Flat, Prism, Solid, cross, dot, normalise
 from ..terminals import UnitMesh
 from .extrude_faces import extrude_faces
 from .selection import check_budget, select, words
-from .trims import corner_planes
+from .trims import corner_planes, edge_planes
 
 # ---- comp(f) -----------------------------------------------------------------------------------
 
@@ -196,17 +198,22 @@ def comp_faces(app, shape, step) -> bool:
     answers = [words(nrm) for _, nrm, _ in faces]
     geom = shape.geom
     walls = isinstance(geom, Prism) or (isinstance(geom, Solid) and geom.name in _BOXES)
+    # with trimming on, a solid's faces get planes where they meet (a 2D shape has one face)
+    shared = edges(faces) if shape.trims is not None and len(faces) > 1 else []
     for entry, selector, chosen in select(app, step, answers):
         for j, i in enumerate(chosen):
             rings, nrm, turns = faces[i]
             face = _face_shape(shape, rings, nrm)
             app.engine.count_shape(app.module, entry.pos)
             corners = _left_right(rings, nrm, turns)
-            # with trimming on, a wall of a solid gets trim planes at its corners (a new comp's
-            # replace the old)
+            # with trimming on, a face of a solid gets trim planes where it meets the others:
+            # a wall's corners as comp.left/right turn, every other edge halving the angle
+            # there (a new comp's replace the old)
             if face.trims is not None:
                 wall = walls and abs(nrm[1]) <= 0.7071
-                face.trims = corner_planes(face, *corners) if wall else ()
+                planes = corner_planes(face, *corners) if wall else ()
+                planes += edge_planes(shape, faces, shared, i, skip_upright=walls)
+                face.trims = replace(face.trims, planes=planes)
             app.piece(face, entry.body, comp=(j, len(chosen), *corners, selector))
     note(app, shape, first=first)  # a mass turning into surfaces occludes (occlusion.py)
     return True

@@ -12,6 +12,7 @@ something (``s('1, 0.2, 0.2) center(yz) i(cube)`` puts a bar along an edge).
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 
 from ..geometry.edges import edges, vertices
 from ..occlusion import note
@@ -48,7 +49,7 @@ def _bare(app, shape, point, axes, size, name: str):
     piece.size = size
     piece.geom = Solid(app.engine.bare_id(name), name)
     if piece.trims is not None:
-        piece.trims = ()
+        piece.trims = replace(piece.trims, planes=())
     return piece
 
 

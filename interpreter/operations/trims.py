@@ -21,6 +21,7 @@ origin), then replays such tiles as before.
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -32,6 +33,36 @@ from ..terminals import UnitMesh
 _EPS = 1e-9
 # what an operation returns when nothing of the shape is left: the engine takes it as NIL
 DELETED = "deleted"
+# a plane whose generating edge rises less than this from the world's horizontal plane is a
+# horizontal one (CGA's trim attribute: 40 degrees)
+HORIZONTAL_BELOW = math.sin(math.radians(40.0))
+
+
+@dataclass(frozen=True, slots=True)
+class Trims:
+    """What a shape knows of trimming: whether vertical and horizontal planes cut (CGA's
+    trim.vertical, on by default there, and trim.horizontal, off), and the planes it carries,
+    each (normal, c, horizontal) in world coordinates, kept where normal . point >= c."""
+
+    vertical: bool
+    horizontal: bool
+    planes: tuple = ()
+
+    def __bool__(self) -> bool:  # "has planes": what the engine asks before moving them
+        return bool(self.planes)
+
+    def cutting(self) -> tuple:
+        """The planes that cut: those of a kind that is on."""
+        return tuple(
+            p for p in self.planes if (self.horizontal if p[2] else self.vertical)
+        )  # fmt: skip
+
+
+def switched(trims: Trims | None, which: str, on: bool) -> Trims | None:
+    """set(trim.vertical | trim.horizontal, on): None once both are off."""
+    now = trims if trims is not None else Trims(False, False)
+    now = replace(now, **{which: on})
+    return now if now.vertical or now.horizontal else None
 
 
 def corner_planes(face: Shape, left: float, right: float) -> tuple:
@@ -43,17 +74,50 @@ def corner_planes(face: Shape, left: float, right: float) -> tuple:
     at_right = face.world((face.size[0], 0.0, 0.0))
     n_left = tuple(face.direction((math.cos(half_l), 0.0, math.sin(half_l))))
     n_right = tuple(face.direction((-math.cos(half_r), 0.0, math.sin(half_r))))
-    return ((n_left, _dot(n_left, at_left)), (n_right, _dot(n_right, at_right)))
+    return ((n_left, _dot(n_left, at_left), False), (n_right, _dot(n_right, at_right), False))
+
+
+def edge_planes(shape: Shape, faces: list, shared: list, index: int, skip_upright: bool) -> tuple:
+    """The trim planes of face ``index`` of a solid (``faces``: comp(f)'s list, in scope
+    metres; ``shared``: geometry.edges.edges of them) at each edge it shares with another face:
+    the plane through the edge halving the angle between the two, kept on this face's side;
+    horizontal when the edge rises less than 40 degrees from the world's horizontal plane.
+    ``skip_upright``: leave out upright edges (a box's walls have corner_planes there)."""
+    out = []
+    normals = [np.asarray(nrm, dtype=np.float64) for _r, nrm, *_ in faces]
+    centre = np.mean(np.asarray(faces[index][0][0], dtype=np.float64), axis=0)
+    for edge in shared:
+        if index not in edge.faces or len(edge.faces) != 2:
+            continue
+        other = edge.faces[1] if edge.faces[0] == index else edge.faces[0]
+        a, b = np.asarray(edge.start), np.asarray(edge.end)
+        along = np.asarray(shape.direction(tuple((b - a).tolist())))
+        rise = abs(along[1]) / (float(np.linalg.norm(along)) or 1.0)
+        if skip_upright and rise > math.cos(math.radians(1.0)):
+            continue
+        halving = normals[index] - normals[other]
+        if float(np.linalg.norm(halving)) < 1e-9:
+            continue  # two faces in one plane: nothing to cut between them
+        if float(np.dot(halving, centre - a)) < 0:
+            halving = -halving
+        normal = np.asarray(shape.direction(tuple(halving.tolist())))
+        normal /= np.linalg.norm(normal)
+        point = shape.world(tuple(a.tolist()))
+        n = tuple(float(v) for v in normal)
+        out.append((n, _dot(n, point), rise < HORIZONTAL_BELOW))
+    return tuple(out)
 
 
 def _dot(a, b) -> float:
     return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 
 
-def kept(shape: Shape) -> tuple:
-    """The shape's trim planes without those it lies farther from than its own largest size."""
+def kept(shape: Shape) -> Trims:
+    """The shape's trims without the planes it lies farther from than its own largest size."""
     reach = max(shape.size)
-    return tuple((n, c) for n, c in shape.trims if _least(shape, n, c) <= reach)
+    trims = shape.trims
+    near = tuple(p for p in trims.planes if _least(shape, p[0], p[1]) <= reach)
+    return trims if len(near) == len(trims.planes) else replace(trims, planes=near)
 
 
 def _least(shape: Shape, normal, c: float) -> float:
@@ -65,24 +129,27 @@ def _least(shape: Shape, normal, c: float) -> float:
     return least
 
 
-def moved_trims(trims: tuple, origin) -> tuple:
+def moved_trims(trims: Trims, origin) -> Trims:
     """Trim planes as seen from ``origin``: a subtree derived at the world's origin (reuse)."""
-    return tuple((normal, c - _dot(normal, origin)) for normal, c in trims)
+    planes = tuple((n, c - _dot(n, origin), h) for n, c, h in trims.planes)
+    return replace(trims, planes=planes)
 
 
 def relative(shape: Shape) -> tuple:
-    """The shape's trim planes relative to its origin, rounded: part of a reuse key."""
-    o = shape.origin
-    return tuple(
-        (round(n[0], 9), round(n[1], 9), round(n[2], 9), round(c - _dot(n, o), 9))
-        for n, c in shape.trims
+    """Which planes cut and where they stand relative to the shape's origin, rounded: part of a
+    reuse key."""
+    o, trims = shape.origin, shape.trims
+    return (trims.vertical, trims.horizontal) + tuple(
+        (round(n[0], 9), round(n[1], 9), round(n[2], 9), round(c - _dot(n, o), 9), h)
+        for n, c, h in trims.planes
     )
 
 
 def trim(app, shape: Shape, step, args):
     """CGA's trim(): the shape's geometry cut by its trim planes now; a 2D shape or a prism
     becomes the mesh of what is left (only when a plane crosses it)."""
-    if not shape.trims or all(_least(shape, n, c) >= 0 for n, c in shape.trims):
+    planes = shape.trims.cutting() if shape.trims else ()
+    if not planes or all(_least(shape, n, c) >= 0 for n, c, _ in planes):
         return False
     geom = shape.geom
     if not isinstance(geom, Solid):  # cut as a mesh, and a prism stays a solid comp(f) opens
@@ -114,7 +181,8 @@ def _flat_again(app, shape: Shape, k: int) -> None:
 
 def trim_insert(app, shape: Shape) -> bool:
     """Cut the shape's inserted mesh by its trim planes; False when nothing of it is left."""
-    if not shape.trims or all(_least(shape, n, c) >= 0 for n, c in shape.trims):
+    planes = shape.trims.cutting() if shape.trims else ()
+    if not planes or all(_least(shape, n, c) >= 0 for n, c, _ in planes):
         return True  # the scope's box (which holds the fitted mesh) is wholly on the kept side
     library = app.engine.table.library
     mesh = library.meshes[shape.geom.mesh]
@@ -123,7 +191,7 @@ def trim_insert(app, shape: Shape) -> bool:
     origin = np.asarray(shape.origin, dtype=np.float64)
     verts, faces, uv = mesh.vertices, mesh.faces, mesh.uv
     changed = False
-    for normal, c in shape.trims:
+    for normal, c, _ in planes:
         # a vertex's signed distance in the mesh's unit coordinates: its world point is
         # origin + (u * size) @ axes (no division by a size, which is 0 across a face)
         n = (axes @ np.asarray(normal)) * size
