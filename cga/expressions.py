@@ -291,3 +291,21 @@ def _show(e: n.Expr) -> str:
     if isinstance(e, n.String):
         return f'"{e.value}"'
     return f"{e.value:g}" if isinstance(e, n.Number) else "0"
+
+
+def bare_word(t) -> str | None:
+    """The bare name an argument is (``x``, ``world.up``, ``inside``), or None."""
+    if isinstance(t, Tree) and t.data == "name":
+        return dotted(t.children[0])
+    if isinstance(t, Tree) and t.data == "dotted":
+        return dotted(t)
+    if isinstance(t, Tree) and t.data in ("true", "false"):
+        return t.data
+    return None
+
+
+def literal_string(t) -> str | None:
+    """The text of an argument that is a string literal, unquoted; None for any other."""
+    if isinstance(t, Tree) and t.data == "string":
+        return unquote(t.children[0])
+    return None

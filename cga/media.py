@@ -9,17 +9,25 @@ import copy
 from lark import Token
 
 from ..grammar import nodes as n
-from . import operations as ops
-from .expressions import dotted, pos, unquote
+from .expressions import bare_word, dotted, literal_string, pos, unquote
+from .lookup import like
+
+# CGA's primitive insertions and the built-in asset each is
+PRIMITIVES = {
+    "primitiveCube": "cube",
+    "primitiveCylinder": "cylinder",
+    "primitiveSphere": "sphere",
+    "primitiveQuad": "quad",
+}
 
 GEOMETRY_FILES = (".obj", ".glb", ".gltf", ".fbx", ".dae", ".ply", ".stl", ".3ds")
 IMAGE_FILES = (".jpg", ".jpeg", ".png", ".tif", ".tiff", ".tga", ".bmp")
 
 
 def asset_of(tr, t, meta) -> n.Expr | None:
-    text = ops.literal_string(t)
-    if text is None and ops._word(t) in tr.consts:
-        text = _const_text(tr, ops._word(t))
+    text = literal_string(t)
+    if text is None and bare_word(t) in tr.consts:
+        text = _const_text(tr, bare_word(t))
     if text is None:
         return None
     return tr.assets.geometry(text, meta, tr.warn)
@@ -28,7 +36,7 @@ def asset_of(tr, t, meta) -> n.Expr | None:
 def _const_text(tr, name: str | None) -> str | None:
     for item in tr.tree.children:
         if item.data == "const_decl" and str(item.children[0]) == name:
-            return ops.literal_string(item.children[2])
+            return literal_string(item.children[2])
     return None
 
 
@@ -54,9 +62,9 @@ def dispatch_insert(tr, t, meta, rest: list) -> list:
 
 
 def texture_path(tr, t, meta) -> n.Expr | None:
-    text = ops.literal_string(t)
-    if text is None and ops._word(t) in tr.consts:
-        text = _const_text(tr, ops._word(t))
+    text = literal_string(t)
+    if text is None and bare_word(t) in tr.consts:
+        text = _const_text(tr, bare_word(t))
     if text is not None:
         return tr.assets.texture(text, meta, tr.warn)
     images = file_strings(tr, IMAGE_FILES)
@@ -74,7 +82,7 @@ def texture_path(tr, t, meta) -> n.Expr | None:
 
 def inserts(tr) -> bool:
     """Whether the file inserts anything (i(), primitiveCube()...): trim planes cut that."""
-    names = {"i", *ops.PRIMITIVES}
+    names = {"i", *PRIMITIVES}
     return any(
         dotted(t.children[0]) in names
         for t in tr.tree.find_pred(lambda t: t.data in ("call", "successor"))
@@ -99,12 +107,10 @@ def ops_key(e: n.Expr) -> str:
 def _computed_files(tr, t) -> list[str]:
     """The asset files a path written ``"prefix" + x + ".obj"`` can name: those beside the
     CGA file that start and end so (a name built from an attr or a random choice)."""
-    from .files import like
-
     if not (hasattr(t, "data") and t.data == "sum"):
         return []
     first, last = t.children[0], t.children[-1]
-    prefix, suffix = ops.literal_string(first), ops.literal_string(last)
+    prefix, suffix = literal_string(first), literal_string(last)
     if prefix is None or suffix is None or not suffix.lower().endswith(GEOMETRY_FILES):
         return []
     return like(prefix, suffix, tr.assets.folder)

@@ -28,7 +28,8 @@ from ..grammar.registry import (
     UP_AXES,
 )
 from . import media, overrides
-from .expressions import dotted, pos, unquote
+from .expressions import bare_word, dotted, pos
+from .media import PRIMITIVES
 
 if TYPE_CHECKING:
     from .translate import Translator
@@ -72,12 +73,6 @@ WORDS_TAKEN = (
     "cleanupGeometry",
 )  # fmt: skip
 ROOFS = {"roofGable": "gable", "roofHip": "hip", "roofPyramid": "pyramid", "roofShed": "shed"}
-PRIMITIVES = {
-    "primitiveCube": "cube",
-    "primitiveCylinder": "cylinder",
-    "primitiveSphere": "sphere",
-    "primitiveQuad": "quad",
-}
 BUILTIN_ASSETS = {"cube": "cube", "cylinder": "cylinder", "sphere": "sphere", "quad": "quad"}
 # operations that change the shape in a way bgr cannot yet: dropped, the shape goes on as it was
 DROPPED = {
@@ -130,7 +125,7 @@ def operation(tr: Translator, name: str, args: list, block, meta, rest: list) ->
         distance = tr.expr(_same_distance(args[0]))
         return _with_block(tr, "setback", [distance], tr.block(block, "setback"), meta), True
     if name in ("innerRectangle", "innerRect") and block is not None:
-        alignment = _word(args[0]) if args else "scope"
+        alignment = bare_word(args[0]) if args else "scope"
         if alignment not in ("scope", "edge"):
             tr.warn(meta, f"innerRectangle({alignment}) is read as innerRectangle(scope)")
             alignment = "scope"
@@ -195,8 +190,8 @@ def same(tr: Translator, name: str, args: list, meta) -> list:
     if name == "color" and len(args) == 4:
         tr.warn(meta, "color()'s alpha is left out (set material.opacity is not in bgr yet)")
         args = args[:3]
-    if name == "r" and args and _word(args[0]) in ("scopeCenter", "scopeOrigin"):
-        centre = _word(args[0]) == "scopeCenter"
+    if name == "r" and args and bare_word(args[0]) in ("scopeCenter", "scopeOrigin"):
+        centre = bare_word(args[0]) == "scopeCenter"
         turn = same(tr, "r", args[1:], meta)
         if not centre or not turn:
             return turn
@@ -205,7 +200,7 @@ def same(tr: Translator, name: str, args: list, meta) -> list:
         back = [n.Relative(n.Number(-0.5)) for _ in range(3)]
         where = pos(meta)
         return [n.Operation("t", half, pos=where), *turn, n.Operation("t", back, pos=where)]
-    word = _word(args[0]) if args else None
+    word = bare_word(args[0]) if args else None
     if name == "envelope" and word == "normal":  # CGA's word for the face's normal
         out.append(n.Name("face.normal"))
         args = args[1:]
@@ -250,13 +245,13 @@ def _absolute(tr: Translator, name: str, arg: n.Relative, before: list, t) -> n.
 
 
 def split(tr: Translator, args: list, block: Tree, meta) -> list:
-    axis = _word(args[0]) if args else None
+    axis = bare_word(args[0]) if args else None
     if axis not in ("x", "y", "z"):
         tr.warn(meta, "split() of this kind is not in bgr yet; its shape is dropped (NIL)")
         return [n.Nil(pos=pos(meta))]
     # CGA fits each piece's scope to its geometry unless told noAdjust; bgr's split keeps the
     # slab's unless told adjust
-    mode = _word(args[1]) if len(args) > 1 else "adjust"
+    mode = bare_word(args[1]) if len(args) > 1 else "adjust"
     if mode not in ("adjust", "noAdjust") or len(args) > 2:
         tr.warn(meta, "split()'s unitSpace/uvSpace arguments are left out")
         mode = "adjust" if mode not in ("adjust", "noAdjust") else mode
@@ -265,7 +260,7 @@ def split(tr: Translator, args: list, block: Tree, meta) -> list:
 
 
 def comp(tr: Translator, args: list, block: Tree, meta) -> list:
-    kind = _word(args[0]) if args else None
+    kind = bare_word(args[0]) if args else None
     if kind not in ("f", "e", "v"):
         tr.warn(
             meta,
@@ -289,7 +284,7 @@ def _same_distance(t):
     if calls[0] is not t or len(entries) != 1:
         return None
     key, value = entries[0].children
-    return value if _word(key) == "all" else None
+    return value if bare_word(key) == "all" else None
 
 
 def _is_fcall_block(t) -> bool:
@@ -314,7 +309,7 @@ def offset(tr: Translator, args: list, meta, rest: list) -> Steps:
         tr.warn(meta, "offset() needs a distance; it is left out")
         return [], False
     distance = negated(tr.expr(args[0]))
-    part = _word(args[1]) if len(args) > 1 else "all"
+    part = bare_word(args[1]) if len(args) > 1 else "all"
     if part in ("inside", "border"):
         body = tr.sequence_of(rest)
         block = n.Block([n.Entry("abs", n.Name(part), body)])
@@ -352,7 +347,7 @@ def _is_comp_f(t) -> bool:
         return False
     name = dotted(t.children[0])
     args = [] if t.children[1] is None else t.children[1].children
-    return name == "comp" and t.children[2] is not None and bool(args) and _word(args[0]) == "f"
+    return name == "comp" and t.children[2] is not None and bool(args) and bare_word(args[0]) == "f"
 
 
 def roof(tr: Translator, name: str, args: list, meta) -> list:
@@ -364,7 +359,7 @@ def roof(tr: Translator, name: str, args: list, meta) -> list:
     extra = args[3:] if name == "roofGable" else args[2:] if name == "roofHip" else args[1:]
     if name == "roofGable" and len(args) > 2 and not _zero(args[2]):
         tr.warn(meta, "roofGable()'s second overhang is not in bgr: the first is used for both")
-    if any(not _zero(a) and _word(a) != "false" for a in extra):
+    if any(not _zero(a) and bare_word(a) != "false" for a in extra):
         tr.warn(meta, f"{name}()'s further arguments are left out")
     return [n.Operation("roof", out, pos=pos(meta))]
 
@@ -392,7 +387,7 @@ def set_value(tr: Translator, args: list, meta) -> list:
     if len(args) != 2:
         tr.warn(meta, "set() takes a name and a value; it is left out")
         return []
-    target = _word(args[0])
+    target = bare_word(args[0])
     if target == "material.name":
         return [n.Operation("material", [tr.expr(args[1])], pos=pos(meta))]
     if target in TEXTURE_MAPS:
@@ -410,30 +405,13 @@ def set_value(tr: Translator, args: list, meta) -> list:
     return [n.Operation("set", [n.Name(attr), tr.expr(args[1])], pos=pos(meta))]
 
 
-def _word(t) -> str | None:
-    """The bare name an argument is (``x``, ``world.up``, ``inside``), or None."""
-    if isinstance(t, Tree) and t.data == "name":
-        return dotted(t.children[0])
-    if isinstance(t, Tree) and t.data == "dotted":
-        return dotted(t)
-    if isinstance(t, Tree) and t.data in ("true", "false"):
-        return t.data
-    return None
-
-
 def _zero(t) -> bool:
     return isinstance(t, Tree) and t.data == "number" and float(str(t.children[0])) == 0.0
 
 
-def literal_string(t) -> str | None:
-    if isinstance(t, Tree) and t.data == "string":
-        return unquote(t.children[0])
-    return None
-
-
 def is_symbol_arg(t, projection: bool) -> str | None:
     """A bare word bgr takes as a symbol: an axis set, or a projection's axes (``scope.xy``)."""
-    word = _word(t)
+    word = bare_word(t)
     if word in SYMBOLS or (projection and word in PROJECTION_AXES_NAMES):
         return word
     if word in ("uv", "uvUniform", "u", "v", "separatePerFace", "collectiveAllFaces"):

@@ -41,7 +41,7 @@ from ..grammar.registry import (
 )
 from . import media, overrides
 from . import operations as ops
-from .expressions import Expressions, dotted, pos, unquote
+from .expressions import Expressions, bare_word, dotted, pos, unquote
 from .start import At, prepend_to_start, shape_attrs
 
 EMPTY = "t"  # a step that changes nothing: a sequence CGA leaves empty keeps its shape as a leaf
@@ -573,7 +573,7 @@ class Translator:
         return out
 
     def selectors(self, t, kind: str, meta, named: set[str]) -> list:
-        word = ops._word(t)
+        word = bare_word(t)
         if kind == "offset":
             words = ["inside", "border"] if word == "all" else [word]
             if word not in ("inside", "border", "all"):

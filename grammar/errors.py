@@ -194,29 +194,3 @@ def source_lines(source: str) -> list[str]:
 def source_line(source: str, line: int) -> str | None:
     lines = source_lines(source)
     return lines[line - 1] if 0 < line <= len(lines) else None
-
-
-def read_json(path, what: str, hint: str | None = None):
-    """The parsed JSON of a file, or a BgrError that says which file and what is wrong with it
-    (``what`` names the file's role: "lot file", "camera file"...)."""
-    import json
-
-    from .paths import read_input  # refuses FIFOs, devices and /proc before opening
-
-    shown = str(path)
-    try:
-        return json.loads(read_input(path, what).decode("utf-8"))
-    except FileNotFoundError:
-        raise BgrError(Diagnostic(shown, 0, 0, f"no such {what}", hint)) from None
-    except (OSError, UnicodeDecodeError) as exc:
-        raise BgrError(Diagnostic(shown, 0, 0, f"cannot read the {what}: {exc}")) from None
-    except json.JSONDecodeError as exc:
-        raise BgrError(
-            Diagnostic(shown, exc.lineno, exc.colno, f"not valid JSON: {exc.msg}")
-        ) from None
-    except ValueError as exc:  # an integer of more digits than Python converts (4,300)
-        raise BgrError(Diagnostic(shown, 0, 0, f"not usable JSON: {exc}")) from None
-    except RecursionError:
-        raise BgrError(
-            Diagnostic(shown, 0, 0, "not usable JSON: it nests arrays or objects too deeply")
-        ) from None

@@ -16,20 +16,9 @@ from .annotations import annotation_warnings
 from .checker import Checker, Grammar
 from .errors import BgrCheckError, BgrError, BgrSyntaxError, Diagnostic, source_line, suggest
 from .parser import parse
-from .paths import ALLOW_HINT, check_input, read_input, roots_of, within
+from .paths import ALLOW_HINT, _stdlib_dir, check_input, read_input, roots_of, within
+from .paths import STDLIB_DIR as STDLIB_DIR
 from .productive import unproductive_cycles
-
-STDLIB_DIR = Path(__file__).resolve().parent.parent / "stdlib"
-
-
-def _stdlib_dir() -> Path:
-    """The bundled stdlib: ``bgr/stdlib`` when installed, ``stdlib/`` in a source checkout."""
-    try:
-        import bgr.stdlib
-
-        return Path(bgr.stdlib.__file__).resolve().parent
-    except ImportError:  # pragma: no cover - only when the grammar package is used on its own
-        return STDLIB_DIR
 
 
 def stdlib_modules() -> list[str]:

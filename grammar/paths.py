@@ -13,6 +13,10 @@ A grammar is code that other people write, so what it names is kept within reach
   ``/proc``, ``/sys`` or ``/dev`` is refused outright, as input and as output.
 * **No foreign text in messages.** Only ``.bgr`` sources are ever quoted in an error; a file
   that is not a ``.bgr`` is refused before it is read as a grammar (see ``loader.read_source``).
+
+The readers built on these checks are here too: :func:`read_input` for bytes and
+:func:`read_json` for a JSON input (a lot, street, camera or terminal file), as is where the
+bundled standard library lies (:func:`_stdlib_dir`, one of every load's roots).
 """
 
 from __future__ import annotations
@@ -29,6 +33,18 @@ SPECIAL_DIRS = tuple(Path(p) for p in ("/proc", "/sys", "/dev"))
 
 ALLOW_HINT = "widen the allowed folders with --allow-path DIR (bgr.load(..., allow_paths=[DIR]))"
 
+STDLIB_DIR = Path(__file__).resolve().parent.parent / "stdlib"
+
+
+def _stdlib_dir() -> Path:
+    """The bundled stdlib: ``bgr/stdlib`` when installed, ``stdlib/`` in a source checkout."""
+    try:
+        import bgr.stdlib
+
+        return Path(bgr.stdlib.__file__).resolve().parent
+    except ImportError:  # pragma: no cover - only when the grammar package is used on its own
+        return STDLIB_DIR
+
 
 def resolved(path: str | os.PathLike) -> Path:
     """``path`` made absolute with every symlink followed (as far as it exists)."""
@@ -40,8 +56,6 @@ def roots_of(
 ) -> tuple[Path, ...]:
     """The folders a load may read: ``base`` (the top-level grammar's folder), the stdlib and
     ``allow_paths``, resolved."""
-    from .loader import _stdlib_dir
-
     return tuple(dict.fromkeys(resolved(p) for p in (base, _stdlib_dir(), *allow_paths)))
 
 
@@ -173,3 +187,27 @@ def _kind(mode: int) -> str:
         if test(mode):
             return name
     return "special file"
+
+
+def read_json(path, what: str, hint: str | None = None):
+    """The parsed JSON of a file, or a BgrError that says which file and what is wrong with it
+    (``what`` names the file's role: "lot file", "camera file"...)."""
+    import json
+
+    shown = str(path)
+    try:
+        return json.loads(read_input(path, what).decode("utf-8"))
+    except FileNotFoundError:
+        raise BgrError(Diagnostic(shown, 0, 0, f"no such {what}", hint)) from None
+    except (OSError, UnicodeDecodeError) as exc:
+        raise BgrError(Diagnostic(shown, 0, 0, f"cannot read the {what}: {exc}")) from None
+    except json.JSONDecodeError as exc:
+        raise BgrError(
+            Diagnostic(shown, exc.lineno, exc.colno, f"not valid JSON: {exc.msg}")
+        ) from None
+    except ValueError as exc:  # an integer of more digits than Python converts (4,300)
+        raise BgrError(Diagnostic(shown, 0, 0, f"not usable JSON: {exc}")) from None
+    except RecursionError:
+        raise BgrError(
+            Diagnostic(shown, 0, 0, "not usable JSON: it nests arrays or objects too deeply")
+        ) from None

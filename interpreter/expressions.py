@@ -17,6 +17,8 @@ from bgr.grammar import nodes as n
 from bgr.grammar.errors import BgrError, Diagnostic, source_line
 from bgr.grammar.registry import BUILTIN_NAMES, OCCLUSION
 
+from .context import Context as Context  # importable from here, as before
+from .context import RuleRef as RuleRef
 from .randomness import Stream, child_hash, name_hash, root_hash
 
 Value = Any
@@ -53,78 +55,6 @@ def _set_or_declared(values: dict, name: str, key: tuple) -> Compiled:
         return values[name]
 
     return attr
-
-
-class Context:
-    """What an expression can see while a shape is being derived."""
-
-    __slots__ = (
-        "shape",
-        "args",
-        "stream",
-        "seed",
-        "split_index",
-        "split_total",
-        "comp_index",
-        "comp_total",
-        "comp_left",
-        "comp_right",
-        "comp_sel",
-        "library",
-        "occlusion",
-    )
-
-    def __init__(
-        self,
-        shape,
-        args: dict,
-        stream,
-        seed: int,
-        indices=(0, 1, 0, 1, 0.0, 0.0, ""),
-        library=None,
-        occlusion=None,
-    ) -> None:
-        """``indices``: split.index, split.total, comp.index, comp.total, the comp face's left
-        and right neighbour angles and its selector, of the piece the shape came from;
-        ``library``: the derivation's unit meshes, which the geometry functions measure a mesh
-        shape by; ``occlusion``: the lot's occluders (occlusion.py), None when the grammar asks
-        no occlusion query."""
-        self.shape, self.args, self.stream, self.seed = shape, args, stream, seed
-        self.library, self.occlusion = library, occlusion
-        (
-            self.split_index,
-            self.split_total,
-            self.comp_index,
-            self.comp_total,
-            self.comp_left,
-            self.comp_right,
-            self.comp_sel,
-        ) = indices
-
-
-class RuleRef:
-    """A rule or terminal handed to a rule parameter as a value (``Facade(window = win.Arched)``).
-
-    It names the module that defines the rule, so a stdlib façade applies the caller's window.
-    """
-
-    __slots__ = ("module", "member")
-
-    def __init__(self, module, member: str) -> None:
-        self.module, self.member = module, member
-
-    def __eq__(self, other) -> bool:
-        return (
-            isinstance(other, RuleRef)
-            and other.module is self.module
-            and other.member == self.member
-        )
-
-    def __hash__(self) -> int:
-        return hash((id(self.module), self.member))
-
-    def __repr__(self) -> str:
-        return f"the rule '{self.member}'"
 
 
 def _num(module, pos, value, what="a number"):

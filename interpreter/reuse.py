@@ -1,4 +1,4 @@
-"""Derive each repeated subtree once (issue 30): a façade repeats the same floor, a floor the
+"""Derive each repeated subtree once: a façade repeats the same floor, a floor the
 same tile, thousands of times, and a rule whose subtree draws no randomness and reads nothing
 of where its shape is gives the same terminals, moved, every time.
 
@@ -24,7 +24,7 @@ from dataclasses import dataclass
 from bgr.grammar import nodes as n
 from bgr.grammar.registry import OCCLUSION, OPERATIONS
 
-from .expressions import RuleRef
+from .context import RuleRef
 from .geometry.polygons import RECT
 from .limits import MEMORY_CHECK_EVERY
 from .operations.trims import relative

@@ -36,7 +36,8 @@ from typing import Any
 
 import numpy as np
 
-from ..grammar.errors import BgrError, Diagnostic, read_json, suggest
+from ..grammar.errors import BgrError, Diagnostic, suggest
+from ..grammar.paths import read_json
 
 # A half turn about y: bgr's world (front facing -z) into the paper's model frame (front facing +z).
 FRONT = np.diag([-1.0, 1.0, -1.0])

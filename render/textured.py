@@ -1,6 +1,6 @@
 """Textured scenes: the images a scene's triangles show, and textured models made into scenes.
 
-A :class:`~.scene.Scene` may carry, per triangle, the index of a :class:`Texture` and the
+A :class:`~.scene_model.Scene` may carry, per triangle, the index of a :class:`Texture` and the
 texture coordinates of its three corners; :mod:`.texturing` samples them per pixel.  This module
 fills them from the two places textures come from:
 
@@ -18,14 +18,12 @@ corner, v growing upwards (CGA, OBJ, CityGML); the glTF writer's flipped v is un
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 import numpy as np
 
 from ..grammar.errors import BgrError, Diagnostic
-
-if TYPE_CHECKING:
-    from .scene import Scene
+from .scene_model import NO_LABEL, Scene, labels_index
 
 WRAPS = ("wrap", "mirror", "clamp", "border", "none")
 
@@ -201,8 +199,6 @@ def from_textured_mesh(mesh, shown: str = "") -> Scene:
     ``baseColorFactor``.  Labels are the surfaces' semantic types where the file has them
     (CityGML's WallSurface, RoofSurface ...), else the material names (``(none)`` without one);
     parts are the polygon or primitive each triangle comes from."""
-    from .scene import NO_LABEL, Scene, labels_index
-
     try:
         vertices = local_frame(mesh.vertices, mesh.up, mesh.crs)
     except ValueError as exc:

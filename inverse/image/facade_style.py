@@ -53,6 +53,7 @@ import numpy as np
 from PIL import Image
 
 from .facade import FacadeParse, rows_of
+from .facade_grid import grid_values
 from .windows import load_weights, predict_proba
 
 WEIGHTS = Path(__file__).with_name("facade_styles.npz")
@@ -290,12 +291,10 @@ def classify(
 
 def fit_params(parse: FacadeParse, rule: str, floor_height: float) -> dict[str, float]:
     """The parameters of ``rule`` read off the parse (metres; ``width`` and ``height`` are the
-    façade's): :func:`~.command.grid_values`' floor, tile and window sizes, and for the
+    façade's): :func:`~.facade_grid.grid_values`' floor, tile and window sizes, and for the
     families with their own ground and top floors those storeys' heights (the middle floors
     then share what is left, less the rule's bands), an odd tile count where the rule has a
     middle column, and the entrance's size where it has one."""
-    from .command import grid_values
-
     values = grid_values(parse, floor_height)
     n = len(parse.floors)
     if rule == DEFAULT_RULE or n == 0:
