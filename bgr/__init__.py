@@ -27,7 +27,7 @@ if TYPE_CHECKING:
     from .interpreter.derive import Result, derive
 
 # The API is imported when first used, not with the package: ``bgr --version`` and a command
-# that needs only the parser start without the interpreter, numpy and trimesh (issue 30).
+# that needs only the parser start without the interpreter, numpy and trimesh.
 _WHERE = {
     "attr_metadata": ".grammar.annotations",
     "Grammar": ".grammar.checker",

@@ -2,7 +2,7 @@
 
 A boundary index of -1 or 10**12 either wraps round to another vertex (numpy counts negative
 indices from the end) or fails deep in numpy with a message that names no object; a vertex of
-NaN or 1e308 would reach earcut (C++) and the Newell normals (issue 25).  Bad indices raise
+NaN or 1e308 would reach earcut (C++) and the Newell normals.  Bad indices raise
 ValueError (read_cityjson names the city object); a surface with a bad vertex is fanned without
 arithmetic, and the city reader's coordinate check (inverse/city/coordinates.py) then names
 the vertex and its city object, as it does for every format.

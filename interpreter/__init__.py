@@ -1,1 +1,1 @@
-"""Derivation of .bgr grammars into meshes: the engine, its operations and geometry (issue 3)."""
+"""Derivation of .bgr grammars into meshes: the engine, its operations and geometry."""

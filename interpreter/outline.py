@@ -2,8 +2,8 @@
 
 Split from :mod:`bgr.interpreter.lots` (which reads GeoJSON and builds lots) because cleaning is
 a concern of its own and must stay fast on outlines of any size: a round footprint traced with
-100,000 corners is ordinary GIS output, and each step here is linear or n log n (issue 34 found
-the collinear-corner pass quadratic: 35 s for 20,000 corners).  The results are the same corner
+100,000 corners is ordinary GIS output, and each step here is linear or n log n (a quadratic
+collinear-corner pass once took 35 s for 20,000 corners).  The results are the same corner
 for corner as the quadratic passes gave; tests/test_linear.py compares them.
 """
 

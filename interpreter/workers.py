@@ -1,7 +1,7 @@
 """A small process pool for ``--workers N`` that dies with its parent and never hangs.
 
 ``concurrent.futures.ProcessPoolExecutor`` runs a manager thread and queue feeder threads
-beside the caller.  Under ``bgr derive --workers N`` that cost three things (issue 34): a
+beside the caller.  Under ``bgr derive --workers N`` that cost three things: a
 worker killed by the kernel surfaced as an internal ``BrokenProcessPool``; a parent killed with
 SIGKILL left its workers blocked forever on a queue they themselves held open (and with them
 the forkserver and the resource tracker, which live while any worker does); and a SIGTERM

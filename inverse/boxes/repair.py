@@ -8,7 +8,7 @@ that overlap or stick out of their parent.
 
 So after the placement of a node's children, :func:`valid` checks them; when they do not fit,
 or open a gap between children that touched in the input (:func:`tiled`: a hole in a wall the
-input closed, issue 24), :func:`fit` finds the valid layout closest to what the placement
+input closed), :func:`fit` finds the valid layout closest to what the placement
 proposed, as two small linear programmes (scipy's HiGHS):
 
 * hard: every child inside the node; a child below another (their cross-sections overlapping)

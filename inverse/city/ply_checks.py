@@ -2,7 +2,7 @@
 
 trimesh believes a PLY header: an ``element vertex 1000000000`` in a 1 KB file makes it size
 arrays by the count, and face indices beyond the vertices or vertices of NaN reach numpy's
-integer casts and bgr's welding as they are (issue 25).  :func:`check_header` refuses counts the
+integer casts and bgr's welding as they are.  :func:`check_header` refuses counts the
 file's size cannot hold, before any allocation; :func:`check_mesh` refuses faces naming
 vertices the file does not have, each with a message that says where.
 """

@@ -2,7 +2,7 @@
 
 :func:`angle` is trimesh's ``oriented_bounds_2D`` (a qhull hull, then every hull edge tried as
 the rectangle's side), turned into the angle :mod:`.components` needs.  It costs ~0.2 ms a call,
-which a city of 100,000 one-triangle objects pays 100,000 times (issue 34), so triangles take
+which a city of 100,000 one-triangle objects pays 100,000 times, so triangles take
 :func:`triangle_angles`: the same arithmetic on all of them at once, in the order qhull hands a
 triangle's edges over: lo the first corner of least x, hi the first of greatest x, mid the
 third, the edges are hi-lo, mid-lo, mid-hi, whichever way the triangle turns.  A triangle that

@@ -2,8 +2,8 @@
 
 Clipping a triangle at a cut plane leaves a triangle on one side and a quad (two triangles) on
 the other, so a wall rectangle (two triangles) crossing one cut becomes six triangles where its
-two strips need four, and every cut a wall crosses adds more (issue 29: Zurich's LoD2 tile went
-from 5,141 triangles to 10,271).  Here the pieces of one slab that lie in one plane (their
+two strips need four, and every cut a wall crosses adds more (Zurich's LoD2 tile went from
+5,141 triangles to 10,271).  Here the pieces of one slab that lie in one plane (their
 source faces' planes equal to 1e-6, and the same colour) are united in that plane (shapely, on a
 grid of a micrometre, so that the two triangles' cuts of a shared edge meet) and triangulated
 again by earcut.  Triangles no cut crosses are not touched, and a group is kept as it was when

@@ -1,4 +1,4 @@
-"""Level 0 without needless cuts (issue 29, item 3): a building whose components are each of a
+"""Level 0 without needless cuts: a building whose components are each of a
 type of their own is put back whole.
 
 Cutting a building into slabs pays where a slab repeats: its type's mesh is written once and

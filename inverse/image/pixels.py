@@ -1,7 +1,7 @@
 """Window pixels of a rectified façade: per-pixel features and two small perceptrons over them.
 
 The paper (section 5.2) detects windows per tile with two CNNs trained on CMP tiles.  bgr has no
-deep-learning framework among its dependencies (issue 28: the package stays small and CPU-only),
+deep-learning framework among its dependencies (the package stays small and CPU-only),
 so the window evidence is a per-pixel classifier instead, in numpy, of two passes (auto-context,
 Tu 2008: the second pass sees what the first one made of the pixel's neighbourhood, which is
 what a CNN's receptive field gives it):

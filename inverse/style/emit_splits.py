@@ -1,5 +1,5 @@
 """Equations 8 and 9 (section 5.2.3) as ``.bgr`` rules, written once per number m of insertable
-pieces, the sizes and the pieces being parameters (issue 27; the style sheet is emit.py's):
+pieces, the sizes and the pieces being parameters (the style sheet itself is emit.py's):
 
     SplitX2(a0, a1, a2, b0, b1, p, c1, c2, d0, d1, d2, s0, s1, s2, i0, i1, w) -->
         SplitX2Fit(.., floor(scope.sx / p))                 x whole patterns of length p
