@@ -19,12 +19,14 @@ from ..grammar import nodes as n
 from ..grammar.cga_table import OPERATION_NAMES as CGA_OPERATIONS
 from ..grammar.registry import (
     CLEANUP_KINDS,
+    COORD_SYSTEMS,
     NUMBER_OR_WORD,
     OPERATIONS,
     PROJECTION_AXES_NAMES,
     SHAPE_ATTRIBUTES,
     SIZE,
     TEX_SIZE,
+    TRANSFORM_MODES,
     UP_AXES,
 )
 from . import media, overrides
@@ -66,11 +68,13 @@ SAME = {
     "mirror",
     "cleanupGeometry",
     "convexify",
+    "rotate",
+    "translate",
 }
 # operations some of whose arguments are bare words
 WORDS_TAKEN = (
     "center", "setupProjection", "normalizeUV", "alignScopeToAxes", "alignScopeToGeometry",
-    "cleanupGeometry",
+    "cleanupGeometry", "rotate", "translate",
 )  # fmt: skip
 ROOFS = {"roofGable": "gable", "roofHip": "hip", "roofPyramid": "pyramid", "roofShed": "shed"}
 BUILTIN_ASSETS = {"cube": "cube", "cylinder": "cylinder", "sphere": "sphere", "quad": "quad"}
@@ -81,8 +85,6 @@ DROPPED = {
     "setNormals",
     "softenNormals",
     "resetMaterial",
-    "rotate",
-    "translate",
     "deleteHoles",
     "modifyVertex",
     "resetGeometry",
@@ -142,14 +144,12 @@ def operation(tr: Translator, name: str, args: list, block, meta, rest: list) ->
         return roof(tr, name, args, meta), False
     if name in PRIMITIVES:
         steps: list = []
-        if len(args) == 3:
-            sizes = [tr.expr(a) for a in args]
-            if all(isinstance(e, n.Number) and e.value >= 0 for e in sizes):
-                steps.append(n.Operation("s", sizes, pos=where))
-            else:  # a negative size extends the box the other way from the scope's origin
-                low = [n.Call("min", [copy.deepcopy(e), n.Number(0.0)]) for e in sizes]
-                steps.append(n.Operation("t", low, pos=where))
-                steps.append(n.Operation("s", [n.Call("abs", [e]) for e in sizes], pos=where))
+        if name == "primitiveCylinder" and len(args) == 3:  # (sides, radius, height)
+            radius, height = tr.expr(args[1]), tr.expr(args[2])
+            steps = _centred_scope(_twice(radius), height, _twice(copy.deepcopy(radius)), where)
+        elif name == "primitiveCube" and len(args) == 3:  # (width, height, depth)
+            width, height, depth = (tr.expr(a) for a in args)
+            steps = _centred_scope(width, height, depth, where)
         return steps + [n.Operation("i", [n.Name(PRIMITIVES[name])], pos=where)], False
     if name == "i":
         return insert(tr, args, meta, rest)
@@ -173,6 +173,32 @@ def operation(tr: Translator, name: str, args: list, block, meta, rest: list) ->
         return [overrides.placeholder(tr, name, args, meta)], False
     tr.warn(meta, f"unknown operation '{name}'; it is left out")
     return [], False
+
+
+def _centred_scope(width: n.Expr, height: n.Expr, depth: n.Expr, where) -> list:
+    """Steps that give a primitive of the sizes CGA names its scope, as CGA places it: in the
+    xz centre of the current scope, on its y = 0 (a negative height reaching down)."""
+
+    def folded(name: str, e: n.Expr, scale: float = 1.0) -> n.Expr:
+        if isinstance(e, n.Number):
+            value = {"abs": abs, "min": lambda v: min(v, 0.0)}[name](e.value)
+            return n.Number(value * scale)
+        args = [copy.deepcopy(e)] + ([n.Number(0.0)] if name == "min" else [])
+        call = n.Call(name, args)
+        return call if scale == 1.0 else n.Binary("*", n.Number(scale), call)
+
+    centre = [n.Relative(n.Number(0.5)), n.Number(0.0), n.Relative(n.Number(0.5))]
+    corner = [folded("abs", width, -0.5), folded("min", height), folded("abs", depth, -0.5)]
+    sizes = [folded("abs", width), folded("abs", height), folded("abs", depth)]
+    return [
+        n.Operation("t", centre, pos=where),
+        n.Operation("t", corner, pos=where),
+        n.Operation("s", sizes, pos=where),
+    ]
+
+
+def _twice(e: n.Expr) -> n.Expr:
+    return n.Number(2 * e.value) if isinstance(e, n.Number) else n.Binary("*", n.Number(2.0), e)
 
 
 def same(tr: Translator, name: str, args: list, meta) -> list:
@@ -209,7 +235,7 @@ def same(tr: Translator, name: str, args: list, meta) -> list:
         and word is not None
         and word.startswith(("world.", "face.", "vertex."))
     ):
-        if word not in ("world.up", "face.normal"):
+        if word not in ("world.up", "world.y", "face.normal"):  # world.y is up, as bgr's
             tr.warn(meta, f"{name}({word}, ...) is erected along world.up")
         out.append(n.Name("world.up" if word != "face.normal" else "face.normal"))
         args = args[1:]
@@ -417,5 +443,7 @@ def is_symbol_arg(t, projection: bool) -> str | None:
     if word in ("uv", "uvUniform", "u", "v", "separatePerFace", "collectiveAllFaces"):
         return word
     if word in UP_AXES or word in CLEANUP_KINDS or any(word in w for w in NUMBER_OR_WORD.values()):
+        return word
+    if word in TRANSFORM_MODES or word in COORD_SYSTEMS:  # rotate's and translate's
         return word
     return None

@@ -434,6 +434,8 @@ class Scene:
         if self.instanced:  # a reader without the extension must refuse the file
             head["extensionsUsed"] = [INSTANCING]
             head["extensionsRequired"] = [INSTANCING]
+        if self.used and (optional := self.materials.extensions()):  # a reader may ignore it
+            head["extensionsUsed"] = head.get("extensionsUsed", []) + optional
         head["scene"] = 0
         head["scenes"] = [{"name": "bgr", "nodes": [0]}]
         root = dict(self.root)

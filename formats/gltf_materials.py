@@ -16,13 +16,14 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from bgr.interpreter.surfaces import DEFAULTS
+from bgr.interpreter.surfaces import ATTRIBUTES, DEFAULTS
 from bgr.interpreter.terminals import TerminalTable
 
 from .materials import Materials, materials_of, surface_text
 from .meshes import MeshPool, face_offsets
 from .texcoords import corner_tangents, corner_uvs
 
+SPECULAR = "KHR_materials_specular"  # a material with set(material.specular.*)
 LINEAR, REPEAT = 9729, 10497
 
 
@@ -34,7 +35,7 @@ class MaterialIndex:
         self.numbers: dict[tuple, int] = {}
         self.names: list[str | None] = []
         self.rgb8: list[np.ndarray] = []
-        self.values: list[tuple[float, float, float]] = []  # opacity, metallic, roughness
+        self.values: list[tuple[float, ...]] = []  # set(material.*): surfaces.ATTRIBUTES
         # per material: (colour map, normal map) image paths, None for none (texcoords.py)
         self.textures: list[tuple[str | None, str | None]] = []
 
@@ -100,6 +101,10 @@ class MaterialIndex:
             labels.append(label)
         return Materials(np.zeros(0, np.int64), rgb8, list(self.names), labels, list(self.values))
 
+    def extensions(self) -> list[str]:
+        """The glTF extensions the materials use (for ``extensionsUsed``)."""
+        return [SPECULAR] if any(v[3:6] != DEFAULTS[3:6] for v in self.values) else []
+
     def members(self, images: dict[str, int], alpha: dict[str, bool]) -> list[dict]:
         """The ``materials`` member: PBR, the colour in linear light, its maps as textures
         (``images``: an image path's texture number; ``alpha``: whether it has alpha)."""
@@ -118,8 +123,14 @@ class MaterialIndex:
             for k in range(len(mats))
         ]
         for k, material in enumerate(materials):
-            if mats.surface(k)[0] < 1.0:  # set(material.opacity, ...): seen through
+            values = mats.surface(k)
+            if values[0] < 1.0:  # set(material.opacity, ...): seen through
                 material["alphaMode"] = "BLEND"
+            if values[3:6] != DEFAULTS[3:6]:  # set(material.specular.*)
+                material["extensions"] = {SPECULAR: {"specularColorFactor": list(values[3:6])}}
+            for i in (6, 7):  # shininess, reflectivity: glTF has no word for them
+                if values[i] != DEFAULTS[i]:
+                    material["extras"][ATTRIBUTES[i]] = values[i]
         for k, (color, normal) in enumerate(self.textures):
             if color is not None:
                 pbr: dict = materials[k]["pbrMetallicRoughness"]

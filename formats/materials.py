@@ -11,7 +11,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from bgr.interpreter.surfaces import DEFAULTS, name_of, values_of
+from bgr.interpreter.surfaces import DEFAULTS, name_of, set_values, values_of
 from bgr.interpreter.terminals import TerminalTable
 
 from .meshes import srgb8
@@ -23,10 +23,10 @@ class Materials:
     rgb8: np.ndarray  # (K, 3) uint8 sRGB
     names: list[str | None]  # (K,) the material() name, or None
     labels: list[str]  # (K,) a display name, unique: the material name, else the colour hex
-    # (K,) (opacity, metallic, roughness) of each, set(material.*) values (interpreter/surfaces)
-    values: list[tuple[float, float, float]] = field(default_factory=list)
+    # (K,) each one's set(material.*) values, in surfaces.ATTRIBUTES order
+    values: list[tuple[float, ...]] = field(default_factory=list)
 
-    def surface(self, k: int) -> tuple[float, float, float]:
+    def surface(self, k: int) -> tuple[float, ...]:
         return self.values[k] if self.values else DEFAULTS
 
     def __len__(self) -> int:
@@ -87,7 +87,7 @@ def materials_of(table: TerminalTable) -> Materials:
     )
 
 
-def surface_text(values: tuple[float, float, float]) -> str:
-    """``opacity 0.4 metallic 0 roughness 0.8``: the values a material label adds."""
-    names = ("opacity", "metallic", "roughness")
-    return " ".join(f"{k} {v:g}" for k, v in zip(names, values, strict=True))
+def surface_text(values: tuple[float, ...]) -> str:
+    """``opacity 0.4 metallic 0 roughness 0.8``: the values a material label adds (and the
+    others where they are set)."""
+    return " ".join(f"{k} {v:g}" for k, v in set_values(values).items())

@@ -279,23 +279,30 @@ def mtl_text(
     files: dict[str, str] | None = None,
     alpha: dict[str, bool] | None = None,
 ) -> bytes:
-    """The .mtl: each material's sRGB colour as ``Kd``, no ambient or specular light; a
+    """The .mtl: each material's sRGB colour as ``Kd``, no ambient light, no specular light
+    unless the grammar set it (``Ks``, ``Ns`` and ``illum 2``: set(material.specular.*,
+    shininess)); a
     textured material (``maps``: its colour and normal map paths) names its images by their
     copies' paths (``files``): ``map_Kd`` the colour map, ``map_d`` it again when it has alpha
     (its opacity), ``map_Bump`` and ``bump`` the normal map."""
     lines = ["# bgr materials"]
     for k, name in enumerate(names):
         r, g, b = (c / 255.0 for c in mats.rgb8[k])
-        opacity, metallic, roughness = mats.surface(k)
+        values = mats.surface(k)
+        opacity, metallic, roughness = values[:3]
+        sr, sg, sb = values[3:6]
+        specular = values[3:7] != DEFAULTS[3:7]  # set(material.specular.*, shininess)
         lines += [
             f"newmtl {name}",
             f"Kd {r:.6g} {g:.6g} {b:.6g}",
             "Ka 0 0 0",
-            "Ks 0 0 0",
+            f"Ks {sr:.6g} {sg:.6g} {sb:.6g}",
             f"d {opacity:.6g}",
-            "illum 1",
+            "illum 2" if specular else "illum 1",  # 2: with the specular highlight
         ]
-        if (opacity, metallic, roughness) != DEFAULTS:  # set(material.*): the PBR extension's
+        if specular:
+            lines.append(f"Ns {values[6]:.6g}")
+        if values != DEFAULTS:  # set(material.*): the PBR extension's
             lines += [f"Pm {metallic:.6g}", f"Pr {roughness:.6g}"]
         color, normal = maps[k] if maps else (None, None)
         if color is not None and files:

@@ -15,7 +15,7 @@ import numpy as np
 
 from bgr.grammar.errors import BgrError
 from bgr.grammar.parser import no_gc
-from bgr.interpreter.surfaces import ATTRIBUTES, Surface, values_of
+from bgr.interpreter.surfaces import Surface, set_values, values_of
 from bgr.interpreter.terminals import TerminalTable, lot_tables
 
 from .meshes import srgb8
@@ -81,7 +81,7 @@ def terminal_dicts(table: TerminalTable) -> list[dict]:
         material = row["material"]
         if isinstance(material, Surface):
             row["material"] = material.name
-            row["surface"] = dict(zip(ATTRIBUTES, values_of(material), strict=True))
+            row["surface"] = set_values(values_of(material))
     return rows
 
 

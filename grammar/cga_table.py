@@ -60,7 +60,13 @@ CGA: list[tuple[str, str, str, str]] = [
     ("NIL", SAME, "NIL", ""),
     ("normalizeUV", SAME, "", ""),
     ("offset", DIFFERENT, "", "a positive distance shrinks (CGA's negative one)"),
-    ("primitiveCube", DIFFERENT, "i(cube)", "also `cylinder`, `sphere`, `quad`, `wedge`"),
+    (
+        "primitiveCube",
+        DIFFERENT,
+        "i(cube)",
+        "also `cylinder`, `sphere`, `quad`, `wedge`; import-cga gives `primitiveCylinder(sides, "
+        "radius, height)` its 2r x height x 2r scope in the xz centre, as CGA's",
+    ),
     ("print", SAME, "", "on standard error, each lot's in derivation order"),
     ("projectUV", SAME, "", ""),
     (
@@ -77,7 +83,7 @@ CGA: list[tuple[str, str, str, str]] = [
     ("roofHip", DIFFERENT, "roof(hip, pitch, overhang)", ""),
     ("roofPyramid", DIFFERENT, "roof(pyramid, pitch, overhang)", ""),
     ("roofShed", DIFFERENT, "roof(shed, pitch, overhang)", ""),
-    ("rotate", NOT_YET, "", "the scope's own turn is `r`"),
+    ("rotate", SAME, "", ""),
     ("rotateScope", SAME, "", ""),
     ("rotateUV", SAME, "", ""),
     ("s", SAME, "", ""),
@@ -87,8 +93,9 @@ CGA: list[tuple[str, str, str, str]] = [
         "set",
         PARTLY,
         "",
-        "attrs; `trim.*`; `material.opacity`, `.metallic`, `.roughness`; `set(material.name, v)` "
-        "is `material(v)`; other shape attributes (specular, shininess...) not yet",
+        "attrs; `trim.*`; `material.opacity`, `.metallic`, `.roughness`, `.specular.r/g/b`, "
+        "`.shininess`, `.reflectivity`; `set(material.name, v)` is `material(v)`; the other "
+        "shape attributes (`material.bumpValue`, `pivot.*`...) not yet",
     ),  # fmt: skip
     (
         "setback",
@@ -117,7 +124,7 @@ CGA: list[tuple[str, str, str, str]] = [
     ("taper", SAME, "", ""),
     ("texture", SAME, "", ""),
     ("tileUV", SAME, "", ""),
-    ("translate", NOT_YET, "", "the scope's own move is `t`"),
+    ("translate", SAME, "", ""),
     ("translateUV", SAME, "", ""),
     (
         "trim",

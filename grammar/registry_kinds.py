@@ -32,6 +32,8 @@ UP_AXIS = "up axis"  # yUp | zUp (alignScopeToGeometry)
 CLEANUP_KIND = "components"  # all | faces | edges | vertices (cleanupGeometry)
 INNER_ALIGNMENT = "alignment"  # scope | edge (innerRectangle)
 SPLIT_ADJUST = "adjustment"  # noAdjust | adjust (split)
+TRANSFORM_MODE = "mode"  # abs | rel (rotate, translate)
+COORD_SYSTEM = "coordinate system"  # scope | pivot | object | world (rotate, translate)
 # a number, or one of a few bare words (alignScopeToGeometry's face and edge)
 FACE_PICK = "face index or selector"  # a number | largest | world.lowest | any
 EDGE_PICK = "edge index or selector"  # a number | longest | world.lowest
@@ -73,15 +75,23 @@ UP_AXES = ("yUp", "zUp")
 CLEANUP_KINDS = ("all", "faces", "edges", "vertices")
 INNER_ALIGNMENTS = ("scope", "edge")
 SPLIT_ADJUSTS = ("noAdjust", "adjust")
+TRANSFORM_MODES = ("abs", "rel")
+COORD_SYSTEMS = ("scope", "pivot", "object", "world")
 # CGA's shape attributes set() may change besides a file's attrs: whether vertical and
-# horizontal trim planes cut (operations/trims.py), and the material's
-# opacity, metallic and roughness (0..1: interpreter/surfaces.py)
+# horizontal trim planes cut (operations/trims.py), and the material's opacity, metallic,
+# roughness, specular colour and reflectivity (0..1) and shininess (0..128:
+# interpreter/surfaces.py)
 SHAPE_ATTRIBUTES = (
     "trim.vertical",
     "trim.horizontal",
     "material.opacity",
     "material.metallic",
     "material.roughness",
+    "material.specular.r",
+    "material.specular.g",
+    "material.specular.b",
+    "material.shininess",
+    "material.reflectivity",
 )
 # kinds that take a number or one of these words
 NUMBER_OR_WORD = {

@@ -9,10 +9,12 @@ from .registry_kinds import (
     AXES,
     AXIS,
     CLEANUP_KIND,
+    COORD_SYSTEM,
     EDGE_PICK,
     FACE_PICK,
     NUMBER,
     SIZE,
+    TRANSFORM_MODE,
     UP_AXIS,
     VALUE,
     Op,
@@ -37,6 +39,39 @@ TRANSFORMS: list[Op] = [
         _sig(Param("x", NUMBER), Param("y", NUMBER), Param("z", NUMBER)),
         "Rotate about the scope origin, in degrees, x then y then z, in scope coordinates.",
         "r(0, 90, 0)",
+    ),
+    Op(
+        "translate",
+        "transforms",
+        _sig(
+            Param("mode", TRANSFORM_MODE),
+            Param("coordSystem", COORD_SYSTEM),
+            Param("x", NUMBER),
+            Param("y", NUMBER),
+            Param("z", NUMBER),
+        ),
+        "CGA's translate: `rel` moves the scope by (x, y, z) metres along the axes of "
+        "`coordSystem`, `abs` puts its origin at the point (x, y, z) of that system. `scope` is "
+        "the shape's own scope (`translate(rel, scope, ...)` is `t`), `world` the axes the "
+        "output is written in (x east, y up, z south) with the site's origin, `object` (and "
+        "`pivot`, the same in bgr) the lot's scope as its start rule received it.",
+        "translate(rel, world, 2, 0, 0)",
+    ),
+    Op(
+        "rotate",
+        "transforms",
+        _sig(
+            Param("mode", TRANSFORM_MODE),
+            Param("coordSystem", COORD_SYSTEM),
+            Param("x", NUMBER),
+            Param("y", NUMBER),
+            Param("z", NUMBER),
+        ),
+        "CGA's rotate, about the scope origin, in degrees, x then y then z: `rel` turns the "
+        "scope by those angles about the axes of `coordSystem` (`rotate(rel, scope, ...)` is "
+        "`r`), `abs` sets its orientation to those angles from that system's (`rotate(abs, "
+        "world, 0, 0, 0)` lines the scope up with the world). The systems are translate's.",
+        "rotate(abs, world, 0, 90, 0)",
     ),
     Op(
         "s",

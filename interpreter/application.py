@@ -17,6 +17,7 @@ from bgr.grammar.registry import (
     AXIS,
     CLEANUP_KIND,
     COMP_KIND,
+    COORD_SYSTEM,
     EXTRUDE_KIND,
     FOOTPRINT_KIND,
     GEOMETRY,
@@ -31,6 +32,7 @@ from bgr.grammar.registry import (
     SIZE,
     SPLIT_ADJUST,
     TEX_SIZE,
+    TRANSFORM_MODE,
     UP_AXIS,
 )
 
@@ -60,6 +62,8 @@ SYMBOL_KINDS = {
     CLEANUP_KIND,
     INNER_ALIGNMENT,
     SPLIT_ADJUST,
+    TRANSFORM_MODE,
+    COORD_SYSTEM,
 }
 _NUMERIC_KINDS = {
     NUMBER,
@@ -69,7 +73,7 @@ _NUMERIC_KINDS = {
 }  # parameters whose value must be a number
 # operations that move or stretch a shape's geometry with its scope: its texture projections and
 # coordinates follow (texturing.follow).  reverseNormals keeps the outline where it is.
-_MOVERS = frozenset({"t", "r", "s", "center", "matrix"})
+_MOVERS = frozenset({"t", "r", "s", "center", "matrix", "translate", "rotate"})
 _NUMBER = (float, int)  # bool is neither: True.__class__ is bool
 EMIT = object()  # marks a children-list entry that is a finished terminal, kept in order
 _NAME_HASHES: dict[str, int] = {}

@@ -106,6 +106,12 @@ class Engine:
         self._bare_ids: set[int] = set()  # the meshes of bare shapes (comp(e), comp(v))
         self.solid_slabs: dict[tuple, object] = {}  # (mesh, axis, lo, hi) -> a split's piece
         self.occlusion = None  # occlusion.Recorder or .Occluders when the grammar asks them
+        # CGA's object coordinate system (rotate, translate): the lot's scope as the start rule
+        # receives it, set by derive()
+        self.object_frame: tuple = (
+            (0.0, 0.0, 0.0),
+            ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0)),
+        )
         self.split_cache: dict = {}  # (block id, sizes, length) -> placed pieces
         self.constant_sizes: dict[int, tuple | None] = {}  # id(entries) -> literal sizes
         # id(operation node) -> its signature (the grammar outlives us)
@@ -188,6 +194,7 @@ class Engine:
                 "give the parameters defaults ('w = 10'), or start from a rule that calls this one",
             )
         lot.path = f"{start}.{index}" if several else start
+        self.object_frame = (tuple(lot.origin), lot.axes)
         lot.hash = child_hash(root_hash(self.seed), name_hash(start), index)
         stack = [(lot, grammar, grammar.rules[start], {}, (0, 1, 0, 1, 0.0, 0.0, ""))]
         reuse, table = self.reuse, self.table

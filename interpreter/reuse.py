@@ -123,13 +123,22 @@ def _steps_ok(module, steps, local: set, known: dict) -> bool:
             if member in target.rules and not _reusable(target, member, known):
                 return False
         elif isinstance(step, n.Operation):
-            if step.name in TEXTURING:
+            if step.name in TEXTURING or _placed_transform(step):
                 return False
             if not all(_expr_ok(module, _value(a), known, local) for a in step.args):
                 return False
             if step.block is not None and not _block_ok(module, step.block.entries, local, known):
                 return False
     return True
+
+
+def _placed_transform(step: n.Operation) -> bool:
+    """translate() to an absolute place, or rotate() or translate() in the lot's own (object)
+    system: what they make depends on where the shape is, or on its lot."""
+    if step.name not in ("translate", "rotate") or len(step.args) < 2:
+        return False
+    mode, system = (a.name if isinstance(a, n.Name) else None for a in step.args[:2])
+    return system in ("object", "pivot") or (step.name == "translate" and mode == "abs")
 
 
 def _block_ok(module, entries, local: set, known: dict) -> bool:

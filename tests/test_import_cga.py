@@ -386,10 +386,18 @@ def test_r_about_the_scope_centre_turns_in_place(tmp_path):
     assert np.allclose(bounds[1] - bounds[0], [2.0, 1.0, 4.0])  # turned a quarter
 
 
-def test_primitive_cube_of_negative_size_extends_the_other_way(tmp_path):
-    out, result = _import(tmp_path, "attr w = -2\nLot --> t(5, 0, 5) primitiveCube(w, 1, 3) Box\n")
+@pytest.mark.parametrize(
+    "call, bounds",
+    [  # the reference's example: 10 x 15 x 20 in the xz centre of the 40 x 30 lot, on y = 0
+        ("primitiveCube(10, 15, 20)", [[15, 0, 5], [25, 15, 25]]),
+        # sizes from attrs; a negative width spans the same, a negative height reaches down
+        ("primitiveCube(w, -1, 3)", [[19, -1, 13.5], [21, 0, 16.5]]),
+    ],
+)
+def test_a_sized_primitive_cube_stands_in_the_xz_centre_of_the_scope(tmp_path, call, bounds):
+    out, result = _import(tmp_path, f"attr w = -2\nLot --> {call} Box\n")
     assert result.warnings == []
-    assert np.allclose(_derive(out).mesh.bounds, [[3, 0, 5], [5, 1, 8]])
+    assert np.allclose(_derive(out).mesh.bounds, bounds)
 
 
 def test_a_style_becomes_a_grammar_that_sets_its_attrs_and_overrides_its_rules(tmp_path):
@@ -499,3 +507,26 @@ def test_import_propagates_attrs_of_the_same_name(tmp_path, args, height):
         path.write_text(text, encoding="utf-8")
     derived = _derive(out, lot=(4.0, 4.0))
     assert derived.mesh.bounds[1][1] == pytest.approx(height)
+
+
+@pytest.mark.parametrize(
+    "call, origin, size",
+    [  # the reference's example (radius 10, height 15), and a radius computed from an attr
+        ("primitiveCylinder(8, 10, 15)", (10.0, 0.0, 5.0), (20.0, 15.0, 20.0)),
+        ("primitiveCylinder(8, r + 1, 3)", (18.5, 0.0, 13.5), (3.0, 3.0, 3.0)),
+    ],
+)
+def test_a_sized_cylinder_stands_in_the_xz_centre_of_the_scope(tmp_path, call, origin, size):
+    out, result = _import(tmp_path, f'version "2014.0"\nattr r = 0.5\nLot --> {call}\n')
+    assert not result.warnings
+    derived = _derive(out)
+    assert derived.terminals.origin[0].tolist() == pytest.approx(origin)
+    assert derived.terminals.size[0].tolist() == pytest.approx(size)
+
+
+def test_extrude_along_world_y_is_world_up_without_a_warning(tmp_path):
+    out, result = _import(
+        tmp_path, "Lot --> extrude(world.y, 3) Mass\nA --> extrude(world.x, 3) B\n"
+    )
+    assert "extrude(world.up, 3)" in out.read_text()
+    assert [w.line for w in result.warnings] == [2]  # world.x is still erected along world.up

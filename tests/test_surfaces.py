@@ -83,3 +83,54 @@ def test_import_cga_translates_them(tmp_path):
     text = result.outputs[tmp_path / "glass.bgr"]
     assert "set(material.opacity, 0.5) set(material.metallic, 1)" in text
     assert [w for w in result.warnings if "material" in w.message] == []
+
+
+SHINY = """terminal Metal, Wall
+Lot --> extrude(6) comp(f) { front: Front | side: Wall }
+Front --> set(material.specular.r, 0.9) set(material.specular.g, 0.8) set(material.specular.b, 0.7)
+    set(material.shininess, 64) set(material.reflectivity, 0.3) material("steel") Metal
+"""
+
+
+def test_specular_shininess_and_reflectivity_reach_every_file(tmp_path):
+    """CGA's specular colour, shininess and reflectivity: glTF's KHR_materials_specular and
+    extras, OBJ's Ks, Ns and illum 2, the terminal list's surface object."""
+    grammar = tmp_path / "shiny.bgr"
+    grammar.write_text(SHINY)
+    result = bgr.derive(bgr.load(grammar), lot=(10, 8))
+    result.save(tmp_path / "out.glb")
+    gltf = gltf_json(tmp_path / "out.glb")
+    assert gltf["extensionsUsed"] == ["KHR_materials_specular"]
+    assert "extensionsRequired" not in gltf  # a reader without it shows the rest
+    steel = next(m for m in gltf["materials"] if m["extras"]["material"] == "steel")
+    factor = steel["extensions"]["KHR_materials_specular"]["specularColorFactor"]
+    assert factor == pytest.approx([0.9, 0.8, 0.7])
+    assert steel["extras"]["shininess"] == 64 and steel["extras"]["reflectivity"] == 0.3
+    wall = next(m for m in gltf["materials"] if m["extras"]["material"] is None)
+    assert "extensions" not in wall and "shininess" not in wall["extras"]
+    result.save(tmp_path / "out.obj")
+    mtl = (tmp_path / "out.mtl").read_text()
+    block = mtl[mtl.index("newmtl steel") :].split("\n\n")[0]
+    assert "Ks 0.9 0.8 0.7" in block and "Ns 64" in block and "illum 2" in block
+    plain = next(b for b in mtl.split("\n\n") if "newmtl" in b and "steel" not in b)
+    assert "Ks 0 0 0" in plain and "illum 1" in plain and "Ns" not in plain
+    result.save(tmp_path / "out.json")
+    rows = json.loads((tmp_path / "out.json").read_text())["terminals"]
+    metal = next(r for r in rows if r["label"] == "Metal")
+    assert metal["surface"] == {
+        "opacity": 1.0,
+        "metallic": 0.0,
+        "roughness": 0.8,
+        "specular.r": 0.9,
+        "specular.g": 0.8,
+        "specular.b": 0.7,
+        "shininess": 64.0,
+        "reflectivity": 0.3,
+    }
+
+
+def test_shininess_goes_to_128_and_no_further():
+    ok = bgr.derive(bgr.load("Lot --> set(material.shininess, 128) A\nterminal A\n"), lot=(4, 4))
+    assert ok.terminals.material[0].shininess == 128
+    with pytest.raises(bgr.BgrError, match="takes a number from 0 to 128"):
+        bgr.derive(bgr.load("Lot --> set(material.shininess, 129) A\nterminal A\n"), lot=(4, 4))

@@ -26,6 +26,8 @@ from . import (
 IMPLEMENTATIONS = {
     "t": transforms.translate,
     "r": transforms.rotate,
+    "translate": transforms.translate_in,
+    "rotate": transforms.rotate_in,
     "s": transforms.scale,
     "center": transforms.center,
     "matrix": transforms.matrix,

@@ -13,7 +13,7 @@ from __future__ import annotations
 from bgr.grammar.registry import SHAPE_ATTRIBUTES
 
 from ..expressions import RuleRef, runtime_error
-from ..surfaces import with_value
+from ..surfaces import LARGEST, with_value
 from .trims import switched
 
 
@@ -26,15 +26,17 @@ def set_attr(app, shape, step, args) -> bool:
             f"set({name}, ...) takes a number, a string or true/false, not the rule "
             f"'{value.member}'",
         )
-    if name.startswith("material."):  # opacity, metallic, roughness: 0..1
+    if name.startswith("material."):  # 0..1, shininess 0..128 (interpreter/surfaces.py)
+        attribute = name.split(".", 1)[1]
+        largest = LARGEST.get(attribute, 1.0)
         whole = isinstance(value, (int, float)) and not isinstance(value, bool)
-        if not whole or not 0.0 <= value <= 1.0:
+        if not whole or not 0.0 <= value <= largest:
             raise runtime_error(
                 app.module,
                 step.pos,
-                f"set({name}, ...) takes a number from 0 to 1, got {value!r}",
+                f"set({name}, ...) takes a number from 0 to {largest:g}, got {value!r}",
             )
-        shape.material = with_value(shape.material, name.split(".", 1)[1], float(value))
+        shape.material = with_value(shape.material, attribute, float(value))
         return False
     if name in SHAPE_ATTRIBUTES:
         if not isinstance(value, bool):

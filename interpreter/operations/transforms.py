@@ -64,6 +64,54 @@ def rotate(app, shape, step, args) -> bool:
     return False
 
 
+WORLD_AXES = ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0))
+
+
+def _system(app, shape, system: str):
+    """(origin, axes) of a coordinate system of rotate() and translate(): the scope's own, the
+    world's (the output's axes, the site's origin), or the object's (and the pivot's, the same
+    in bgr): the lot's scope as the start rule received it."""
+    if system == "scope":
+        return tuple(shape.origin), shape.axes
+    if system == "world":
+        return (0.0, 0.0, 0.0), WORLD_AXES
+    return app.engine.object_frame
+
+
+def translate_in(app, shape, step, args) -> bool:
+    """CGA's translate(mode, coordSystem, x, y, z): ``rel`` moves the scope's origin by the
+    vector, ``abs`` puts it at the point; both in the system's axes (scope: as ``t``)."""
+    mode, system = args[0], args[1]
+    vector = [float(v) for v in args[2:5]]
+    origin, axes = _system(app, shape, system)
+    offset = [sum(vector[i] * axes[i][k] for i in range(3)) for k in range(3)]
+    base = shape.origin if mode == "rel" or system == "scope" else origin
+    shape.origin = [base[k] + offset[k] for k in range(3)]
+    return False
+
+
+def rotate_in(app, shape, step, args) -> bool:
+    """CGA's rotate(mode, coordSystem, x, y, z), about the scope's origin: the system's axes
+    turned by the angles (x, then y, then z, each about the turned axes, as ``r``) are the
+    scope's new axes in ``abs`` mode; in ``rel`` mode the motion that turns the system so is
+    applied to the scope's axes (in the scope's own system both are ``r``)."""
+    mode, system = args[0], args[1]
+    frame = _system(app, shape, system)[1]
+    turned = frame
+    for axis, degrees in enumerate(args[2:5]):
+        if degrees:
+            turned = _rotate_axes(turned, axis, float(degrees))
+    if mode == "abs":
+        shape.axes = turned
+        return False
+    # frame[j] -> turned[j]: a vector v goes to sum_j turned[j] (frame[j] . v)
+    shape.axes = tuple(
+        tuple(sum(turned[j][k] * dot(frame[j], axis) for j in range(3)) for k in range(3))
+        for axis in shape.axes
+    )
+    return False
+
+
 def center(app, shape, step, args) -> bool:
     which, received = args[0], args[-1]
     # the centre of the received scope, in this scope's frame
