@@ -17,9 +17,11 @@ from bgr.grammar import nodes as n
 from bgr.grammar.errors import BgrError, Diagnostic, source_line
 from bgr.grammar.registry import BUILTIN_NAMES, OCCLUSION
 
+from . import string_lists
 from .context import Context as Context  # importable from here, as before
 from .context import RuleRef as RuleRef
 from .randomness import Stream, child_hash, name_hash, root_hash
+from .string_lists import FUNCTIONS as STRING_LISTS
 
 Value = Any
 Compiled = Callable[["Context"], Value]
@@ -103,6 +105,7 @@ _TEXT = {
     "count": (lambda s, m: float(s.count(m)) if m else 0.0, (str, str)),
     "find": (_find, (str, str, float)),
     "substring": (_substring, (str, float, float)),
+    **STRING_LISTS,  # listItem, listSize ...: CGA's string lists ("a;b;c;")
 }
 
 
@@ -381,7 +384,24 @@ class Compiler:
         if name in ("min", "max"):
             fn = min if name == "min" else max
             return lambda ctx: fn(_num(module, pos, a(ctx)) for a in args)
-        if name in _TEXT:  # CGA's string functions: len, count, find, substring
+        if name == "listRandom":  # an item of a string list, drawn from the shape's stream
+            (text,) = args
+
+            def list_random(ctx):
+                value = text(ctx)
+                if not isinstance(value, str):
+                    raise runtime_error(
+                        module, pos, f"listRandom() needs a string, got {_show(value)}"
+                    )
+                found = string_lists.items(value)
+                return (
+                    found[min(int(ctx.stream.uniform() * len(found)), len(found) - 1)]
+                    if found
+                    else ""
+                )
+
+            return list_random
+        if name in _TEXT:  # CGA's string functions: len, count, find, substring, list*
             fn, kinds = _TEXT[name]
 
             def text_call(ctx):

@@ -45,7 +45,7 @@ PLACED = {
     "depth",
     "seed",
 }
-RANDOM = {"rand", "randint", "p"}
+RANDOM = {"rand", "randint", "p", "listRandom"}
 OCCLUDED = set(OCCLUSION)  # occlusion queries: their answer depends on the lot around the shape
 # a subtree of up to this many terminals is kept the first time it is derived (a tile, a floor);
 # a larger one the second time (grid_city at n = 20: 1.34 s and 374 MB keeping all the first

@@ -1,0 +1,53 @@
+"""CGA's string lists: several strings in one, each followed by a semicolon (``"a;b;c;"``),
+and the functions of CGA's utility library that read and build them (``listItem``,
+``listSize``, ``listRandom``...).  They are strings, not arrays, so a list travels through
+attrs, parameters and ``+`` like any other string.  A last item without its semicolon is read
+as an item, as the functions CityEngine ships do.
+"""
+
+from __future__ import annotations
+
+
+def items(text: str) -> list[str]:
+    """The items of a string list (the empty piece after the last semicolon is no item)."""
+    parts = text.split(";")
+    return parts[:-1] if parts and parts[-1] == "" else parts
+
+
+def joined(parts: list[str]) -> str:
+    """A string list of ``parts``, each followed by its semicolon."""
+    return "".join(f"{p};" for p in parts)
+
+
+def list_item(text: str, index: float) -> str:
+    """The item at ``index`` (0-based); "" past either end."""
+    found = items(text)
+    i = int(index)
+    return found[i] if 0 <= i < len(found) else ""
+
+
+def list_index(text: str, item: str) -> float:
+    """Where ``item`` first stands in the list (0-based), or -1."""
+    found = items(text)
+    return float(found.index(item)) if item in found else -1.0
+
+
+def list_range(text: str, start: float, end: float) -> str:
+    """The items from ``start`` up to, not including, ``end``, as a string list."""
+    found = items(text)
+    lo = max(0, int(start))
+    return joined(found[lo : max(lo, int(end))])
+
+
+# name: (function, the types of its arguments), as expressions.py's string functions
+FUNCTIONS = {
+    "listSize": (lambda s: float(len(items(s))), (str,)),
+    "listItem": (list_item, (str, float)),
+    "listIndex": (list_index, (str, str)),
+    "listCount": (lambda s, item: float(items(s).count(item)), (str, str)),
+    "listFirst": (lambda s: list_item(s, 0), (str,)),
+    "listLast": (lambda s: (items(s) or [""])[-1], (str,)),
+    "listAdd": (lambda s, item: joined([*items(s), item]), (str, str)),
+    "listRange": (list_range, (str, float, float)),
+    "listTerminate": (lambda s: joined(items(s)), (str,)),
+}
