@@ -123,9 +123,10 @@ def operation(tr: Translator, name: str, args: list, block, meta, rest: list) ->
         body = tr.block(block, "innerRectangle")
         return _with_block(tr, name, [tr.expr(a) for a in args], body, meta), True
     if name == "setback" and block is not None and len(args) == 1 and _same_distance(args[0]):
-        # setback(comp(fe) { all: d }): every edge the same distance, as setback(d)
+        # setback(comp(fe) { all: d }): setback(d), or setbackPerEdge(d) where d reads the edge
         distance = tr.expr(_same_distance(args[0]))
-        return _with_block(tr, "setback", [distance], tr.block(block, "setback"), meta), True
+        op = "setbackPerEdge" if _per_component(distance) else "setback"
+        return _with_block(tr, op, [distance], tr.block(block, "setback"), meta), True
     if name in ("innerRectangle", "innerRect") and block is not None:
         alignment = bare_word(args[0]) if args else "scope"
         if alignment not in ("scope", "edge"):
@@ -133,12 +134,14 @@ def operation(tr: Translator, name: str, args: list, block, meta, rest: list) ->
             alignment = "scope"
         body = tr.block(block, "innerRectangle")
         return _with_block(tr, "innerRectangle", [n.Name(alignment)], body, meta), True
-    if name == "setback":
-        tr.warn(
-            meta,
-            "setback() with a distance per edge (comp(fe) { ... }) is not in bgr yet; "
-            "its shape is dropped (NIL)",
-        )
+    if name in ("setback", "setbackPerEdge") and block is not None and len(args) == 1:
+        # setback(comp(fe) { front = 5 | all = 2 }): a distance per edge, as setbackPerEdge
+        distance = _per_edge(tr, args[0], meta) if name == "setback" else tr.expr(args[0])
+        if distance is not None:
+            body = tr.block(block, "setback")
+            return _with_block(tr, "setbackPerEdge", [distance], body, meta), True
+    if name in ("setback", "setbackPerEdge"):
+        tr.warn(meta, f"{name}() of this form is not in bgr yet; its shape is dropped (NIL)")
         return [n.Nil(pos=where)], True
     if name in ROOFS:
         return roof(tr, name, args, meta), False
@@ -311,6 +314,66 @@ def _same_distance(t):
         return None
     key, value = entries[0].children
     return value if bare_word(key) == "all" else None
+
+
+def _per_component(e) -> bool:
+    """Whether an expression can differ from one component to the next: it reads the
+    component's scope, comp.*, geometry or draws a random number."""
+    if isinstance(e, n.Name):
+        return e.name.startswith(("comp.", "scope.", "geometry."))
+    if isinstance(e, n.Call) and (
+        e.name in ("rand", "randint", "p", "listRandom") or e.name.startswith("geometry.")
+    ):
+        return True
+    children = [
+        getattr(e, f, None) for f in ("operand", "left", "right", "cond", "then", "otherwise")
+    ]
+    children += list(getattr(e, "args", None) or [])
+    return any(_per_component(c) for c in children if c is not None)
+
+
+# the comp(fe) selectors a distance per edge can name, as the scope's (bgr's setback words)
+_EDGE_WORDS = ("front", "back", "left", "right", "top", "bottom")
+
+
+def _per_edge(tr: Translator, t, meta) -> n.Expr | None:
+    """``comp(fe) { front = 5 | side = 3 | all = 1 }`` as one expression of comp.sel and
+    comp.index for setbackPerEdge: each edge takes the value of the first entry that selects
+    it, and no setback (0) when none does, as CGA's comp function gives; None for any other
+    argument.  ``object.`` and ``street.`` selectors are read as the scope's (CGA reads street
+    selectors as object ones where the lot has no street widths)."""
+    if not (isinstance(t, Tree) and t.data == "fcall_block" and dotted(t.children[0]) == "comp"):
+        return None
+    entries = [c for c in t.children if isinstance(c, Tree) and c.data == "value_entry"]
+    chain: list[tuple[n.Expr | None, n.Expr]] = []
+    for key, value in (e.children for e in entries):
+        word = bare_word(key) or ""
+        plain = word.split(".", 1)[1] if word.startswith(("object.", "street.")) else word
+        if plain != word:
+            tr.warn(meta, f"setback selector '{word}' is read as '{plain}'")
+        sel = n.Name("comp.sel")
+        if plain == "all":
+            condition = None
+        elif plain in _EDGE_WORDS:
+            condition = n.Binary("==", sel, n.String(plain))
+        elif plain == "side":
+            condition = n.Binary(
+                "or",
+                n.Binary("==", sel, n.String("left")),
+                n.Binary("==", copy.deepcopy(sel), n.String("right")),
+            )
+        elif isinstance(key, Tree) and key.data == "number":
+            condition = n.Binary("==", n.Name("comp.index"), tr.expr(key))
+        else:
+            tr.warn(meta, f"setback selector '{word or 'this'}' is not in bgr yet; left out")
+            continue
+        chain.append((condition, tr.expr(value)))
+        if condition is None:
+            break
+    out: n.Expr = n.Number(0.0)
+    for condition, value in reversed(chain):
+        out = value if condition is None else n.Ternary(condition, value, out)
+    return out
 
 
 def _is_fcall_block(t) -> bool:

@@ -101,9 +101,12 @@ CGA: list[tuple[str, str, str, str]] = [
         "setback",
         PARTLY,
         "",
-        "one distance (`comp(fe) { all: d }` too), the scope's edge selectors, side, all and "
-        "remainder; distances that differ per edge, street and uv selectors not yet",
+        "one distance, the scope's edge selectors, side, all and remainder; a distance per "
+        "edge from `comp(fe) { front = 5 | all = 2 }` (import-cga writes it as "
+        "`setbackPerEdge` of comp.sel), `street.`/`object.` selectors read as the scope's; "
+        "arrays and uv selectors not yet",
     ),
+    ("setbackPerEdge", SAME, "", ""),
     ("setNormals", NOT_YET, "", ""),
     ("setPivot", NOT_YET, "", ""),
     ("setupProjection", SAME, "", ""),

@@ -46,6 +46,7 @@ from .registry import (
     NUMBER_OR_WORD,
     OFFSET_SELECTORS,
     OPERATIONS,
+    PER_EDGE,
     PRIMITIVES,
     PROJECTION_AXES,
     PROJECTION_AXES_NAMES,
@@ -253,7 +254,7 @@ class OperationChecks(ExpressionChecks):
         expr = arg.expr if isinstance(arg, n.Relative) else arg
         if op.name in _TEXTURE_OPS and isinstance(expr, n.String):
             self.texture_file(expr)
-        if kind in (NUMBER, SIZE, TEX_SIZE) and isinstance(expr, (n.String, n.Bool)):
+        if kind in (NUMBER, SIZE, TEX_SIZE, PER_EDGE) and isinstance(expr, (n.String, n.Bool)):
             self.error(expr.pos, f"the {pname} of '{op.name}' must be a number")
         elif kind == STRING and isinstance(expr, (n.Number, n.Bool)):
             self.error(

@@ -13,6 +13,7 @@ from .registry_kinds import (
     FOOTPRINT_KIND,
     INNER_ALIGNMENT,
     NUMBER,
+    PER_EDGE,
     SPLIT_ADJUST,
     Op,
     Param,
@@ -63,6 +64,17 @@ SPLITS_AND_COMPONENTS: list[Op] = [
         "edge's strip (`front`, `back`, `left`, `right`, `top`, `bottom`: by its outward "
         "normal in the scope's quadrants; `side`, `all`) is a piece, `remainder` the rest.",
         "setback(3) { front: Yard | remainder: Building }",
+        block="setback",
+    ),
+    Op(
+        "setbackPerEdge",
+        "components",
+        _sig(Param("distance", PER_EDGE)),
+        "setback with a distance for each edge, as CGA's: `distance` is evaluated once per "
+        "edge of the outline with the edge as the current shape (its `scope.sx` the edge's "
+        "length, `comp.sel` its selector word, `comp.index` its number round the outline); "
+        "the selectors are setback's.",
+        'setbackPerEdge(comp.sel == "front" ? 5 : 2) { all: Yard | remainder: Building }',
         block="setback",
     ),
     Op(

@@ -33,6 +33,8 @@ CLEANUP_KIND = "components"  # all | faces | edges | vertices (cleanupGeometry)
 INNER_ALIGNMENT = "alignment"  # scope | edge (innerRectangle)
 SPLIT_ADJUST = "adjustment"  # noAdjust | adjust (split)
 TRANSFORM_MODE = "mode"  # abs | rel (rotate, translate)
+# a number evaluated once per edge, the edge as the current shape (setbackPerEdge)
+PER_EDGE = "distance per edge"
 COORD_SYSTEM = "coordinate system"  # scope | pivot | object | world (rotate, translate)
 # a number, or one of a few bare words (alignScopeToGeometry's face and edge)
 FACE_PICK = "face index or selector"  # a number | largest | world.lowest | any

@@ -27,6 +27,7 @@ from bgr.grammar.registry import (
     NUMBER,
     NUMBER_OR_WORD,
     OPERATIONS,
+    PER_EDGE,
     PROJECTION_AXES,
     ROOF_KIND,
     SIZE,
@@ -265,7 +266,13 @@ class Application:
             plan = self.engine.signatures[id(step)] = self.plan(step)
         ctx = self.ctx
         out = [
-            value if kind == 0 else fn(ctx) if kind == 1 else (value, fn(ctx))
+            value
+            if kind == 0
+            else fn(ctx)
+            if kind == 1
+            else (value, fn(ctx))
+            if kind == 2
+            else fn  # 3: evaluated by the operation, once per part (setbackPerEdge)
             for kind, value, fn, _ in plan
         ]
         for i, value in enumerate(out):
@@ -298,7 +305,8 @@ class Application:
 
     def plan(self, step: n.Operation) -> tuple:
         """(kind, constant, compiled, numeric) per parameter: kind 0 a word or default, 1 a
-        value, 2 relative; numeric: the parameter takes a number (or a size)."""
+        value, 2 relative, 3 an expression the operation evaluates itself (once per edge);
+        numeric: the parameter takes a number (or a size)."""
         spec, count = OPERATIONS[step.name], len(step.args)
         sig = next(
             s
@@ -319,6 +327,9 @@ class Application:
                 and arg.name in NUMBER_OR_WORD[param.kind]
             ):
                 plan.append((0, arg.name, None, False))
+            elif param.kind == PER_EDGE:
+                compiled = self.engine.compiled(self.compiler, arg, self.local)
+                plan.append((3, None, compiled, False))
             elif isinstance(arg, n.Relative):
                 tag = "float" if arg.floating else "rel"
                 compiled = self.engine.compiled(self.compiler, arg.expr, self.local)

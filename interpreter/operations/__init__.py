@@ -42,6 +42,7 @@ IMPLEMENTATIONS = {
     "comp": parts.comp,
     "offset": components.offset,
     "setback": setbacks.setback,
+    "setbackPerEdge": setbacks.setback,
     "innerRectangle": setbacks.inner_rectangle,
     "shapeL": setbacks.shape_luo,
     "shapeU": setbacks.shape_luo,

@@ -1,8 +1,11 @@
 """setback(distance) { selector: ... | remainder: ... }: CGA's setback of a 2D shape's edges
-(interpreter/geometry/setbacks.py holds the geometry); innerRectangle, and shapeL, shapeU and
-shapeO, CGA's L, U and O (ring) shapes cut from a 2D shape's scope."""
+(interpreter/geometry/setbacks.py holds the geometry), and setbackPerEdge(distance), its
+distance evaluated once per edge with the edge as the current shape; innerRectangle, and
+shapeL, shapeU and shapeO, CGA's L, U and O (ring) shapes cut from a 2D shape's scope."""
 
 from __future__ import annotations
+
+import math
 
 from bgr.grammar import nodes as n
 
@@ -11,29 +14,37 @@ from ..geometry.meshes import PLANE_AXES
 from ..geometry.polygons import RECT, UNIT_SQUARE, is_unit_square
 from ..geometry.polygons import normalise as normalise_polys
 from ..geometry.setbacks import edge_kinds, strips
-from ..shapes import Flat
+from ..shapes import Flat, cross
 
 _SIDES = ("left", "right", "front", "back")
 
 
 def setback(app, shape, step, args) -> bool:
-    distance = float(args[0])
+    """setback(distance) and setbackPerEdge(distance): see the module docstring."""
     geom = shape.geom
     if not isinstance(geom, Flat):
         raise runtime_error(
             app.module,
             step.pos,
-            "setback() needs a 2D shape",
+            f"{step.name}() needs a 2D shape",
             "set back the edges of a lot, or of a face from comp(f)",
-        )
-    if distance < 0:
-        raise runtime_error(
-            app.module, step.pos, f"setback() distance {distance:g} is negative", "grow with offset"
         )
     p, q = PLANE_AXES[geom.k]
     su, sv = shape.size[p], shape.size[q]
     polys = [(UNIT_SQUARE, ())] if geom.polys == RECT else geom.polys
     edges = edge_kinds(polys, su, sv, p, q)
+    if step.name == "setbackPerEdge":
+        each = _per_edge(app, shape, step, args[0], edges, p, q)
+    else:
+        each = [float(args[0])] * len(edges)
+    for d in each:
+        if d < 0:
+            raise runtime_error(
+                app.module,
+                step.pos,
+                f"{step.name}() distance {d:g} is negative",
+                "grow with offset",
+            )
     taken = [False] * len(edges)
     chosen: list[tuple[n.Entry, list[int]]] = []
     for entry in step.block.entries:
@@ -50,6 +61,7 @@ def setback(app, shape, step, args) -> bool:
             taken[i] = True
         chosen.append((entry, picked))
     order = sorted(i for _, picked in chosen for i in picked)
+    distance = [each[i] for i in order] if step.name == "setbackPerEdge" else (each or [0.0])[0]
     parts, rest = strips(polys, su, sv, [edges[i][0] for i in order], distance)
     part_of = dict(zip(order, parts, strict=True))
     for entry, picked in chosen:
@@ -59,6 +71,38 @@ def setback(app, shape, step, args) -> bool:
         if entry.key.name == "remainder":
             _piece(app, shape, step, entry, rest, p, q, geom.k)
     return True
+
+
+def _per_edge(app, shape, step, distance, edges, p: int, q: int) -> list[float]:
+    """setbackPerEdge's distance evaluated once per edge, as CGA's: the current shape is then
+    the edge (its scope's x along it, from its start, a size of (length, 0, 0)), comp.sel its
+    selector word and comp.index its number round the outline."""
+    ctx = app.ctx
+    saved = (ctx.shape, ctx.comp_index, ctx.comp_total, ctx.comp_sel)
+    normal = [0.0, 0.0, 0.0]
+    normal[3 - p - q] = 1.0
+    out = []
+    try:
+        for i, ((a, b), kind) in enumerate(edges):
+            start, along = [0.0, 0.0, 0.0], [0.0, 0.0, 0.0]
+            start[p], start[q] = a
+            along[p], along[q] = b[0] - a[0], b[1] - a[1]
+            length = math.hypot(*along)
+            x = [c / length for c in along]
+            edge = shape.copy().cut_from(shape)
+            edge.origin = shape.world(start)
+            edge.axes = tuple(tuple(shape.direction(v)) for v in (x, normal, cross(x, normal)))
+            edge.size = [length, 0.0, 0.0]
+            ctx.shape, ctx.comp_index, ctx.comp_total, ctx.comp_sel = edge, i, len(edges), kind
+            value = distance(ctx)
+            if isinstance(value, bool) or not isinstance(value, (int, float)):
+                raise runtime_error(
+                    app.module, step.pos, f"{step.name}()'s distance is a number, got {value!r:.40}"
+                )
+            out.append(float(value))
+    finally:
+        ctx.shape, ctx.comp_index, ctx.comp_total, ctx.comp_sel = saved
+    return out
 
 
 def _piece(app, shape, step, entry, metric_polys, p: int, q: int, k: int) -> None:
