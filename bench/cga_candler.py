@@ -27,7 +27,8 @@ PYPRT = """
 import json, sys, pyprt
 rpk, w, d = sys.argv[1], float(sys.argv[2]), float(sys.argv[3])
 pyprt.initialize_prt()
-lot = [0, 0, 0, 0, 0, d, w, 0, d, w, 0, 0]  # y up, the normal pointing up
+# the first edge (the scope's x, as bgr's --lot W,D) along +x and W long, the normal up
+lot = [0, 0, d, w, 0, d, w, 0, 0, 0, 0, 0]
 out = {}
 for mode in ("3DPrint", "Visualization"):
     model = pyprt.ModelGenerator([pyprt.InitialShape(lot)])

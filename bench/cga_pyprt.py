@@ -26,7 +26,8 @@ from bgr.cga.files import translate_file
 PYPRT = """
 import json, sys, pyprt
 rpk, w, d = sys.argv[1], float(sys.argv[2]), float(sys.argv[3])
-lot = [0, 0, 0, 0, 0, d, w, 0, d, w, 0, 0]  # y up, the normal pointing up
+# the first edge (the scope's x, as bgr's --lot W,D) along +x and W long, the normal up
+lot = [0, 0, d, w, 0, d, w, 0, 0, 0, 0, 0]
 model = pyprt.ModelGenerator([pyprt.InitialShape(lot)])
 g = model.generate_model([{}], rpk, "com.esri.pyprt.PyEncoder",
                          {"emitReport": True, "emitGeometry": True})[0]
