@@ -166,8 +166,20 @@ class Expressions:
         return neutral(name)
 
     def _array(self, t: Tree) -> n.Expr:
-        self.ctx.warn(t.meta, "arrays are not in bgr yet; 0 stands in")
-        return n.Number(0.0)
+        rows = [c for c in t.children if isinstance(c, Tree) and c.data == "args"]
+        if len(rows) > 1:
+            self.ctx.warn(t.meta, "arrays of two dimensions are not in bgr yet; 0 stands in")
+            return n.Number(0.0)
+        return n.Array([self(a) for a in _args(rows[0])] if rows else [], pos=pos(t.meta))
+
+    def _index(self, t: Tree) -> n.Expr:
+        target, where = t.children[0], _args(t.children[1])
+        if len(where) != 1:
+            self.ctx.warn(
+                t.meta, "an item of a two-dimensional array is not in bgr yet; 0 stands in"
+            )
+            return n.Number(0.0)
+        return n.Index(self(target), self(where[0]), pos=pos(t.meta))
 
     def _fcall(self, t: Tree) -> n.Expr:
         name = dotted(t.children[0])

@@ -117,8 +117,9 @@ def operation(tr: Translator, name: str, args: list, block, meta, rest: list) ->
     if name == "offset":
         return offset(tr, args, meta, rest)
     if name == "setback" and block is not None and len(args) == 1 and not _is_fcall_block(args[0]):
-        body = tr.block(block, "setback")
-        return _with_block(tr, "setback", [tr.expr(args[0])], body, meta), True
+        # setback(distances) with an array: a distance per edge, setbackPerEdge's array form
+        op = "setbackPerEdge" if _array_valued(tr, args[0]) else "setback"
+        return _with_block(tr, op, [tr.expr(args[0])], tr.block(block, "setback"), meta), True
     if name in ("shapeL", "shapeU", "shapeO") and block is not None:
         body = tr.block(block, "innerRectangle")
         return _with_block(tr, name, [tr.expr(a) for a in args], body, meta), True
@@ -316,20 +317,24 @@ def _same_distance(t):
     return value if bare_word(key) == "all" else None
 
 
+def _array_valued(tr: Translator, t) -> bool:
+    """An array literal, or the name of an attr or const the file sets to one."""
+    if isinstance(t, Tree) and t.data == "array":
+        return True
+    return bare_word(t) in tr.arrays
+
+
 def _per_component(e) -> bool:
     """Whether an expression can differ from one component to the next: it reads the
     component's scope, comp.*, geometry or draws a random number."""
-    if isinstance(e, n.Name):
-        return e.name.startswith(("comp.", "scope.", "geometry."))
-    if isinstance(e, n.Call) and (
-        e.name in ("rand", "randint", "p", "listRandom") or e.name.startswith("geometry.")
-    ):
-        return True
-    children = [
-        getattr(e, f, None) for f in ("operand", "left", "right", "cond", "then", "otherwise")
-    ]
-    children += list(getattr(e, "args", None) or [])
-    return any(_per_component(c) for c in children if c is not None)
+    for x in n.walk(e):
+        if isinstance(x, n.Name) and x.name.startswith(("comp.", "scope.", "geometry.")):
+            return True
+        if isinstance(x, n.Call) and (
+            x.name in ("rand", "randint", "p", "listRandom") or x.name.startswith("geometry.")
+        ):
+            return True
+    return False
 
 
 # the comp(fe) selectors a distance per edge can name, as the scope's (bgr's setback words)

@@ -85,6 +85,7 @@ class Translator:
         self.funcs: dict[str, tuple[str, int]] = {}
         self.attrs: dict[str, str] = {}
         self.consts: dict[str, str] = {}
+        self.arrays: set[str] = set()  # the CGA attrs and consts whose value is an array literal
         self.imports: dict[str, str | None] = {}
         # per import alias: (CGA rule, arity) -> its bgr name there (overrides.rules_of)
         self.import_rules: dict[str, dict[tuple[str, int], str]] = {}
@@ -156,6 +157,8 @@ class Translator:
                 self.consts[str(item.children[0])] = self.fresh(
                     str(item.children[0]), _PLAIN_BUILTINS
                 )
+            if kind in ("attr_decl", "const_decl") and _is_array(item.children[-1]):
+                self.arrays.add(str(item.children[0]))
         for name, arities in self.arities.items():
             for k, arity in enumerate(sorted(arities)):
                 bgr = name if k == 0 else f"{name}_{arity}"
@@ -620,3 +623,8 @@ def _on_attr(note: n.Annotation) -> bool:
 def _on_rule(note: n.Annotation) -> bool:
     spec = SPECS.get(note.name)
     return spec is None or "rule" in spec.targets
+
+
+def _is_array(t) -> bool:
+    """An array literal (``[1, 2, 3]``), which setback() reads as a distance per edge."""
+    return isinstance(t, Tree) and t.data == "array"

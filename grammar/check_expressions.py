@@ -54,6 +54,10 @@ class ExpressionChecks(CheckerBase):
                 stack.append(e.operand)
             elif isinstance(e, n.Ternary):
                 stack += (e.otherwise, e.then, e.cond)
+            elif isinstance(e, n.Array):
+                stack += reversed(e.items)
+            elif isinstance(e, n.Index):
+                stack += (e.index, e.target)
             elif isinstance(e, n.Call):
                 self.call(e)
                 if e.name in OCCLUSION:

@@ -101,6 +101,13 @@ def format_expr(e) -> str:
         return e.name
     if isinstance(e, n.Call):
         return f"{e.name}({', '.join(format_arg(a) for a in e.args)})"
+    if isinstance(e, n.Array):
+        return f"[{', '.join(format_expr(a) for a in e.items)}]"
+    if isinstance(e, n.Index):
+        target = format_expr(e.target)
+        if _level(e.target) < _ATOM:
+            target = f"({target})"
+        return f"{target}[{format_expr(e.index)}]"
     if isinstance(e, n.Relative):
         return ("~" if e.floating else "'") + format_expr(e.expr)
     if isinstance(e, n.Unary):

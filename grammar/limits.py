@@ -52,6 +52,10 @@ def children(e) -> list:
         return [e.expr]
     if isinstance(e, n.Keyword):
         return [e.value]
+    if isinstance(e, n.Array):
+        return list(e.items)
+    if isinstance(e, n.Index):
+        return [e.target, e.index]
     return []
 
 

@@ -110,7 +110,24 @@ class Keyword:
     pos: Pos = _pos()
 
 
-Expr = Number | String | Bool | Name | Call | Unary | Binary | Ternary
+@dataclass
+class Array:
+    """``[a, b, c]``: CGA's array, its items all numbers, all strings or all booleans."""
+
+    items: list
+    pos: Pos = _pos()
+
+
+@dataclass
+class Index:
+    """``a[i]``: the i-th (0-based) item of an array."""
+
+    target: Expr
+    index: Expr
+    pos: Pos = _pos()
+
+
+Expr = Number | String | Bool | Name | Call | Unary | Binary | Ternary | Array | Index
 Arg = Expr | Relative | Keyword
 
 
@@ -375,6 +392,10 @@ def walk(expr) -> Iterator:
             stack += e.args
         elif isinstance(e, (Relative, Keyword)):
             stack.append(e.expr if isinstance(e, Relative) else e.value)
+        elif isinstance(e, Array):
+            stack += e.items
+        elif isinstance(e, Index):
+            stack += (e.target, e.index)
 
 
 def names_in(expr) -> Iterator[Name]:
@@ -396,3 +417,7 @@ def names_in(expr) -> Iterator[Name]:
             stack.append(e.expr)
         elif isinstance(e, Keyword):
             stack.append(e.value)
+        elif isinstance(e, Array):
+            stack += e.items
+        elif isinstance(e, Index):
+            stack += (e.target, e.index)

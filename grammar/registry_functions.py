@@ -93,6 +93,18 @@ BUILTINS: dict[str, Builtin] = {
             "substring(s, start, end)",
             "the characters of s from start up to, not including, end.",
         ),
+        # CGA's arrays: [1, 2, 3], a[i]
+        Builtin(
+            "size", 1, 1, "size(a)", "the number of items of an array (of a string: its length)."
+        ),
+        Builtin("index", 2, 2, "index(a, v)", "where v first stands in the array a, or -1."),
+        Builtin(
+            "splitString",
+            2,
+            2,
+            "splitString(s, separator)",
+            "the pieces of s between the separators, as an array of strings.",
+        ),
         # CGA's string lists: items each followed by a semicolon, "a;b;c;"
         Builtin("listSize", 1, 1, "listSize(list)", "the number of items of a string list."),
         Builtin("listItem", 2, 2, "listItem(list, i)", 'the i-th item (0-based); "" past the end.'),

@@ -367,6 +367,13 @@ class _TreeBuilder(Transformer):
     def ternary(self, c):
         return n.Ternary(c[0], c[1], c[2], pos=_span(c))
 
+    def array(self, c):
+        items = [x for x in c[1:-1] if x is not None]
+        return n.Array(items, pos=_tok_pos(c[0]))
+
+    def index(self, c):
+        return n.Index(c[0], c[2], pos=_tok_pos(c[1]))
+
     def term(self, c):
         return c  # prefix operator tokens, then the operand; ordered by chain()
 

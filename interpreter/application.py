@@ -280,15 +280,16 @@ class Application:
             if number.__class__ in _NUMBER:
                 if not -MAX_COORDINATE <= number <= MAX_COORDINATE:
                     self.out_of_range(step, i, number)
-            elif number.__class__ is str and plan[i][3]:
+            elif number.__class__ in (str, tuple) and plan[i][3]:
                 # the checker types most arguments; a value it cannot type, such as
                 # `c ? "a" : 1`, is known only now
+                what = "an array" if number.__class__ is tuple else f"{number!r:.40}"
                 raise runtime_error(
                     self.module,
                     step.pos,
-                    f"{step.name}() needs a finite number, got {number!r:.40} (argument {i + 1})",
-                    "a string where a number goes: an attr set to text, or a conditional "
-                    "whose branches give a string?",
+                    f"{step.name}() needs a finite number, got {what} (argument {i + 1})",
+                    "a string or an array where a number goes: an attr set to one, or a "
+                    "conditional whose branches give one?",
                 )
         out.append(received)
         return out

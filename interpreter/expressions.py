@@ -17,11 +17,10 @@ from bgr.grammar import nodes as n
 from bgr.grammar.errors import BgrError, Diagnostic, source_line
 from bgr.grammar.registry import BUILTIN_NAMES, OCCLUSION
 
-from . import string_lists
+from . import arrays, string_lists
 from .context import Context as Context  # importable from here, as before
 from .context import RuleRef as RuleRef
 from .randomness import Stream, child_hash, name_hash, root_hash
-from .string_lists import FUNCTIONS as STRING_LISTS
 
 Value = Any
 Compiled = Callable[["Context"], Value]
@@ -70,6 +69,8 @@ def _show(value) -> str:
         return "true" if value else "false"
     if isinstance(value, str):
         return f'the string "{value}"'
+    if isinstance(value, tuple):
+        return f"an array of {len(value)}"
     return repr(value)  # numbers, and RuleRef: "the rule 'Arched'"
 
 
@@ -82,42 +83,21 @@ def number_text(text: str) -> float | None:
     return value if math.isfinite(value) else None
 
 
-def _find(text: str, match: str, n: float) -> float:
-    """CGA's find(): where the n-th (0-based) occurrence of ``match`` starts, or -1."""
-    at, start = -1, 0
-    for _ in range(int(n) + 1):
-        at = text.find(match, start)
-        if at < 0 or not match:
-            return float(at)
-        start = at + len(match)
-    return float(at)
-
-
-def _substring(text: str, start: float, end: float) -> str:
-    """CGA's substring(): the characters from ``start`` up to, not including, ``end``."""
-    lo = max(0, int(start))
-    hi = max(lo, min(len(text), int(end)))
-    return text[lo:hi]
-
-
-_TEXT = {
-    "len": (lambda s: float(len(s)), (str,)),
-    "count": (lambda s, m: float(s.count(m)) if m else 0.0, (str, str)),
-    "find": (_find, (str, str, float)),
-    "substring": (_substring, (str, float, float)),
-    **STRING_LISTS,  # listItem, listSize ...: CGA's string lists ("a;b;c;")
-}
+_TEXT = string_lists.TEXT  # len, count, find, substring, and the string lists'
 
 
 def as_text(value) -> str | None:
     """CGA's str(): a string as it is, true/false, a number to 10 significant digits without a
-    trailing ".0" (str(1.69) is "1.69", str(2.0) "2"); None for what has no text (a rule)."""
+    trailing ".0" (str(1.69) is "1.69", str(2.0) "2"), an array as ``(3)[1,2,3]``; None for
+    what has no text (a rule)."""
     if isinstance(value, str):
         return value
     if isinstance(value, bool):
         return "true" if value else "false"
     if isinstance(value, (int, float)):
         return format(value, ".10g")
+    if isinstance(value, tuple):  # an array, as CityEngine prints one: (3)[1,2,3]
+        return f"({len(value)})[{','.join(str(as_text(v)) for v in value)}]"
     return None
 
 
@@ -254,7 +234,31 @@ class Compiler:
             return self.binary(e, local)
         if isinstance(e, n.Call):
             return self.call(e, local)
+        if isinstance(e, (n.Array, n.Index)):
+            return self.array(e, local)
         raise TypeError(f"not an expression: {e!r}")
+
+    def array(self, e: n.Array | n.Index, local: frozenset) -> Compiled:
+        """``[a, b]`` and ``a[i]`` (arrays.py), their problems reported at their place."""
+        module, pos = self.module, e.pos
+        if isinstance(e, n.Array):
+            parts = [self.expr(x, local) for x in e.items]
+
+            def make(values):
+                return arrays.array_of(values)
+        else:
+            parts = [self.expr(e.target, local), self.expr(e.index, local)]
+
+            def make(values):
+                return arrays.item(*values)
+
+        def evaluate(ctx):
+            try:
+                return make([f(ctx) for f in parts])
+            except arrays.ArrayError as problem:
+                raise runtime_error(module, pos, str(problem)) from None
+
+        return evaluate
 
     def ternary(self, e: n.Ternary, local: frozenset) -> Compiled:
         """``c1 ? a : c2 ? b : d``: the else spine is one loop, however long (grammar.limits)."""
@@ -401,6 +405,15 @@ class Compiler:
                 )
 
             return list_random
+        if name in arrays.FUNCTIONS:  # size, index, splitString
+
+            def array_call(ctx, fn=arrays.FUNCTIONS[name][0]):
+                try:
+                    return fn(*[f(ctx) for f in args])
+                except arrays.ArrayError as problem:
+                    raise runtime_error(module, pos, str(problem)) from None
+
+            return array_call
         if name in _TEXT:  # CGA's string functions: len, count, find, substring, list*
             fn, kinds = _TEXT[name]
 

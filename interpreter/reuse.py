@@ -279,6 +279,9 @@ def _expr_ok(
         return all(
             _expr_ok(module, e, known, local, seen) for e in (node.cond, node.then, node.otherwise)
         )
+    if isinstance(node, (n.Array, n.Index)):
+        parts = node.items if isinstance(node, n.Array) else [node.target, node.index]
+        return all(_expr_ok(module, e, known, local, seen) for e in parts)
     return True  # a number, a string, a boolean
 
 

@@ -1,8 +1,9 @@
-"""CGA's string lists: several strings in one, each followed by a semicolon (``"a;b;c;"``),
-and the functions of CGA's utility library that read and build them (``listItem``,
-``listSize``, ``listRandom``...).  They are strings, not arrays, so a list travels through
-attrs, parameters and ``+`` like any other string.  A last item without its semicolon is read
-as an item, as the functions CityEngine ships do.
+"""CGA's string functions (``len``, ``count``, ``find``, ``substring``) and its string lists:
+several strings in one, each followed by a semicolon (``"a;b;c;"``), with the functions of
+CGA's utility library that read and build them (``listItem``, ``listSize``, ``listRandom``...).
+A string list is a string, not an array (arrays.py), so it travels through attrs, parameters
+and ``+`` like any other string.  A last item without its semicolon is read as an item, as the
+functions CityEngine ships do.
 """
 
 from __future__ import annotations
@@ -50,4 +51,32 @@ FUNCTIONS = {
     "listAdd": (lambda s, item: joined([*items(s), item]), (str, str)),
     "listRange": (list_range, (str, float, float)),
     "listTerminate": (lambda s: joined(items(s)), (str,)),
+}
+
+
+def _find(text: str, match: str, n: float) -> float:
+    """CGA's find(): where the n-th (0-based) occurrence of ``match`` starts, or -1."""
+    at, start = -1, 0
+    for _ in range(int(n) + 1):
+        at = text.find(match, start)
+        if at < 0 or not match:
+            return float(at)
+        start = at + len(match)
+    return float(at)
+
+
+def _substring(text: str, start: float, end: float) -> str:
+    """CGA's substring(): the characters from ``start`` up to, not including, ``end``."""
+    lo = max(0, int(start))
+    hi = max(lo, min(len(text), int(end)))
+    return text[lo:hi]
+
+
+# name: (function, the types of its arguments), every string function expressions.py compiles
+TEXT = {
+    "len": (lambda s: float(len(s)), (str,)),
+    "count": (lambda s, m: float(s.count(m)) if m else 0.0, (str, str)),
+    "find": (_find, (str, str, float)),
+    "substring": (_substring, (str, float, float)),
+    **FUNCTIONS,  # listItem, listSize ...: the string lists
 }

@@ -408,8 +408,9 @@ def polygon(app, shape, step, args) -> bool:
 
 def _signed_height(app, step, value) -> float:
     if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
+        shown = "an array" if isinstance(value, tuple) else repr(value)
         raise runtime_error(
-            app.module, step.pos, f"{step.name}() needs a finite number, got {value!r}"
+            app.module, step.pos, f"{step.name}() needs a finite number, got {shown}"
         )
     return float(value)
 

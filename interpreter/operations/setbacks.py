@@ -76,7 +76,8 @@ def setback(app, shape, step, args) -> bool:
 def _per_edge(app, shape, step, distance, edges, p: int, q: int) -> list[float]:
     """setbackPerEdge's distance evaluated once per edge, as CGA's: the current shape is then
     the edge (its scope's x along it, from its start, a size of (length, 0, 0)), comp.sel its
-    selector word and comp.index its number round the outline."""
+    selector word and comp.index its number round the outline.  An array as the value gives
+    edge i its item i (none past its end), as CGA's setback(distances)."""
     ctx = app.ctx
     saved = (ctx.shape, ctx.comp_index, ctx.comp_total, ctx.comp_sel)
     normal = [0.0, 0.0, 0.0]
@@ -95,6 +96,8 @@ def _per_edge(app, shape, step, distance, edges, p: int, q: int) -> list[float]:
             edge.size = [length, 0.0, 0.0]
             ctx.shape, ctx.comp_index, ctx.comp_total, ctx.comp_sel = edge, i, len(edges), kind
             value = distance(ctx)
+            if isinstance(value, tuple):  # CGA's setback(distances): edge i takes item i
+                value = value[i] if i < len(value) else 0.0
             if isinstance(value, bool) or not isinstance(value, (int, float)):
                 raise runtime_error(
                     app.module, step.pos, f"{step.name}()'s distance is a number, got {value!r:.40}"
