@@ -23,6 +23,7 @@ from ..grammar.registry import (
     NUMBER_OR_WORD,
     OPERATIONS,
     PROJECTION_AXES_NAMES,
+    ROTATION_PIVOTS,
     SHAPE_ATTRIBUTES,
     SIZE,
     TEX_SIZE,
@@ -70,11 +71,13 @@ SAME = {
     "convexify",
     "rotate",
     "translate",
+    "deleteHoles",
+    "resetMaterial",
 }
 # operations some of whose arguments are bare words
 WORDS_TAKEN = (
     "center", "setupProjection", "normalizeUV", "alignScopeToAxes", "alignScopeToGeometry",
-    "cleanupGeometry", "rotate", "translate",
+    "cleanupGeometry", "rotate", "translate", "r",
 )  # fmt: skip
 ROOFS = {"roofGable": "gable", "roofHip": "hip", "roofPyramid": "pyramid", "roofShed": "shed"}
 BUILTIN_ASSETS = {"cube": "cube", "cylinder": "cylinder", "sphere": "sphere", "quad": "quad"}
@@ -84,8 +87,6 @@ DROPPED = {
     "setPivot",
     "setNormals",
     "softenNormals",
-    "resetMaterial",
-    "deleteHoles",
     "modifyVertex",
     "resetGeometry",
     "splitAndSetbackPerimeter",
@@ -220,16 +221,6 @@ def same(tr: Translator, name: str, args: list, meta) -> list:
     if name == "color" and len(args) == 4:
         tr.warn(meta, "color()'s alpha is left out (set material.opacity is not in bgr yet)")
         args = args[:3]
-    if name == "r" and args and bare_word(args[0]) in ("scopeCenter", "scopeOrigin"):
-        centre = bare_word(args[0]) == "scopeCenter"
-        turn = same(tr, "r", args[1:], meta)
-        if not centre or not turn:
-            return turn
-        # about the scope's centre: to the centre, turn, and back along the turned axes
-        half = [n.Relative(n.Number(0.5)) for _ in range(3)]
-        back = [n.Relative(n.Number(-0.5)) for _ in range(3)]
-        where = pos(meta)
-        return [n.Operation("t", half, pos=where), *turn, n.Operation("t", back, pos=where)]
     word = bare_word(args[0]) if args else None
     if name == "envelope" and word == "normal":  # CGA's word for the face's normal
         out.append(n.Name("face.normal"))
@@ -512,6 +503,6 @@ def is_symbol_arg(t, projection: bool) -> str | None:
         return word
     if word in UP_AXES or word in CLEANUP_KINDS or any(word in w for w in NUMBER_OR_WORD.values()):
         return word
-    if word in TRANSFORM_MODES or word in COORD_SYSTEMS:  # rotate's and translate's
-        return word
+    if word in TRANSFORM_MODES or word in COORD_SYSTEMS or word in ROTATION_PIVOTS:
+        return word  # rotate's and translate's, r's pivot
     return None

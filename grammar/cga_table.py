@@ -37,7 +37,7 @@ CGA: list[tuple[str, str, str, str]] = [
         "`fe`, `fv`, `g`, `m`, `h`, the `=` operator, street and object selectors not yet",
     ),
     ("convexify", PARTLY, "", "2D shapes; a solid's faces not yet"),
-    ("deleteHoles", NOT_YET, "", ""),
+    ("deleteHoles", PARTLY, "", "2D shapes and solids; an extrusion with a courtyard not yet"),
     ("deleteUV", SAME, "", ""),
     (
         "envelope",
@@ -69,15 +69,9 @@ CGA: list[tuple[str, str, str, str]] = [
     ),
     ("print", SAME, "", "on standard error, each lot's in derivation order"),
     ("projectUV", SAME, "", ""),
-    (
-        "r",
-        PARTLY,
-        "",
-        "about the scope's origin; import-cga writes `r(scopeCenter, x, y, z)` as "
-        "`t('0.5, '0.5, '0.5) r(x, y, z) t('-0.5, '-0.5, '-0.5)`",
-    ),
+    ("r", SAME, "", "about the scope's origin, or its centre: `r(scopeCenter, x, y, z)`"),
     ("report", SAME, "", "each lot's values summed up per key; `bgr derive --reports`"),
-    ("resetMaterial", NOT_YET, "", ""),
+    ("resetMaterial", SAME, "", "the colour a shape never coloured has (`#cccccc`)"),
     ("reverseNormals", SAME, "", ""),
     ("roofGable", DIFFERENT, "roof(gable, pitch, overhang)", ""),
     ("roofHip", DIFFERENT, "roof(hip, pitch, overhang)", ""),

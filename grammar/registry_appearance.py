@@ -69,6 +69,15 @@ ROOFS_INSERTS_APPEARANCE: list[Op] = [
         'material("brick")',
     ),
     Op(
+        "resetMaterial",
+        "appearance",
+        _sig(),
+        "Reset the material, as CGA's resetMaterial: the colour a shape never coloured has "
+        "(`#cccccc`), no material name, no set(material.*) values, no texture projections or "
+        "maps.",
+        "resetMaterial()",
+    ),
+    Op(
         "label",
         "appearance",
         _sig(Param("name", STRING)),

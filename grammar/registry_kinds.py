@@ -35,6 +35,7 @@ SPLIT_ADJUST = "adjustment"  # noAdjust | adjust (split)
 TRANSFORM_MODE = "mode"  # abs | rel (rotate, translate)
 # a number evaluated once per edge, the edge as the current shape (setbackPerEdge)
 PER_EDGE = "distance per edge"
+ROTATION_PIVOT = "pivot"  # scopeOrigin | scopeCenter (r)
 COORD_SYSTEM = "coordinate system"  # scope | pivot | object | world (rotate, translate)
 # a number, or one of a few bare words (alignScopeToGeometry's face and edge)
 FACE_PICK = "face index or selector"  # a number | largest | world.lowest | any
@@ -78,6 +79,7 @@ CLEANUP_KINDS = ("all", "faces", "edges", "vertices")
 INNER_ALIGNMENTS = ("scope", "edge")
 SPLIT_ADJUSTS = ("noAdjust", "adjust")
 TRANSFORM_MODES = ("abs", "rel")
+ROTATION_PIVOTS = ("scopeOrigin", "scopeCenter")
 COORD_SYSTEMS = ("scope", "pivot", "object", "world")
 # CGA's shape attributes set() may change besides a file's attrs: whether vertical and
 # horizontal trim planes cut (operations/trims.py), and the material's opacity, metallic,

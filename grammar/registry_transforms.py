@@ -13,6 +13,7 @@ from .registry_kinds import (
     EDGE_PICK,
     FACE_PICK,
     NUMBER,
+    ROTATION_PIVOT,
     SIZE,
     TRANSFORM_MODE,
     UP_AXIS,
@@ -36,8 +37,17 @@ TRANSFORMS: list[Op] = [
     Op(
         "r",
         "transforms",
-        _sig(Param("x", NUMBER), Param("y", NUMBER), Param("z", NUMBER)),
-        "Rotate about the scope origin, in degrees, x then y then z, in scope coordinates.",
+        (
+            (Param("x", NUMBER), Param("y", NUMBER), Param("z", NUMBER)),
+            (
+                Param("pivot", ROTATION_PIVOT),
+                Param("x", NUMBER),
+                Param("y", NUMBER),
+                Param("z", NUMBER),
+            ),
+        ),
+        "Rotate about the scope origin, in degrees, x then y then z, in scope coordinates; "
+        "`r(scopeCenter, x, y, z)` about the scope's centre (`scopeOrigin`: its origin), as CGA's.",
         "r(0, 90, 0)",
     ),
     Op(
@@ -145,6 +155,15 @@ TRANSFORMS: list[Op] = [
         "CGA's cleanupGeometry (`all`, `faces`, `edges` or `vertices`: each is read as all); "
         "bgr's own shapes are exact, so it changes inserted meshes and outlines from files.",
         "cleanupGeometry(all, 0.01)",
+    ),
+    Op(
+        "deleteHoles",
+        "transforms",
+        _sig(),
+        "Fill the holes of a 2D shape's polygons (a courtyard, a window cut), as CGA's "
+        "deleteHoles; a solid's faces have none, except an extrusion of a footprint with a "
+        "courtyard, which is not in bgr yet (a runtime error).",
+        "deleteHoles()",
     ),
     Op(
         "convexify",

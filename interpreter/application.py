@@ -30,6 +30,7 @@ from bgr.grammar.registry import (
     PER_EDGE,
     PROJECTION_AXES,
     ROOF_KIND,
+    ROTATION_PIVOT,
     SIZE,
     SPLIT_ADJUST,
     TEX_SIZE,
@@ -65,6 +66,7 @@ SYMBOL_KINDS = {
     SPLIT_ADJUST,
     TRANSFORM_MODE,
     COORD_SYSTEM,
+    ROTATION_PIVOT,
 }
 _NUMERIC_KINDS = {
     NUMBER,

@@ -41,6 +41,7 @@ class Solid:
 
 
 _new_shape = object.__new__
+DEFAULT_COLOR = (0.8, 0.8, 0.8)  # a shape never coloured: #cccccc
 
 
 class Shape:
@@ -69,7 +70,7 @@ class Shape:
         axes,
         size,
         geom,
-        color=(0.8, 0.8, 0.8),
+        color=DEFAULT_COLOR,
         material=None,
         label=None,
         path="",

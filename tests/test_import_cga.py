@@ -135,14 +135,14 @@ def test_what_bgr_lacks_is_reported_at_its_place_and_left_out(tmp_path):
     extrude(10)
     comp(f) { front: Front | side: Side }
 Front --> comp(h) { all: Edge }
-Side --> deleteHoles() color(case inside(all): 1 else: 0, 0, 0)
+Side --> softenNormals(30) color(case inside(all): 1 else: 0, 0, 0)
 Edge --> color(1, 0, 0)
 """,
     )
     found = {(w.line, w.column): w.message for w in result.warnings}
     assert "setPivot" in found[(1, 9)]
     assert "comp(h)" in found[(4, 11)]
-    assert "deleteHoles" in found[(5, 10)]
+    assert "softenNormals" in found[(5, 10)]
     labels = _labels(_derive(out))
     assert "Edge" not in labels and labels["Side"] == 3  # comp(h) stood as NIL
 
@@ -230,12 +230,12 @@ def test_a_file_that_does_not_parse_at_all_is_an_error_at_its_place(tmp_path):
 
 def test_cli_writes_the_grammar_and_strict_writes_nothing(tmp_path):
     src = tmp_path / "box.cga"
-    src.write_text("Lot --> extrude(3) deleteHoles() Box\nBox --> color(1,0,0)\n")
+    src.write_text("Lot --> extrude(3) softenNormals(30) Box\nBox --> color(1,0,0)\n")
     out = tmp_path / "box.bgr"
     cmd = [sys.executable, "-m", "bgr", "import-cga", str(src)]
     strict = subprocess.run([*cmd, "-o", str(out), "--strict"], capture_output=True, text=True)
     assert strict.returncode == 1 and not out.exists()
-    assert f"{src}:1:20: error: deleteHoles() is not in bgr yet" in strict.stderr
+    assert f"{src}:1:20: error: softenNormals() is not in bgr yet" in strict.stderr
     done = subprocess.run([*cmd, "-o", str(out)], capture_output=True, text=True)
     assert done.returncode == 0, done.stderr
     assert f"{src}:1:20: warning:" in done.stderr and "1 construct not translated" in done.stderr

@@ -119,3 +119,17 @@ def test_import_cga_translates_rotate_and_translate(tmp_path):
     assert "rotate(rel, world, 0, 45, 0)" in text and "translate(rel, object, 1, 0, 0)" in text
     assert not [w for w in result.warnings if "rotate" in w.message or "translate" in w.message]
     assert rows(text)
+
+
+def test_r_about_the_scope_centre_keeps_the_centre():
+    (box,) = rows("Lot --> s(4, 4, 2) r(scopeCenter, 0, 90, 0) i(cube)")
+    x, y, z = box["axes"]
+    centre = [box["origin"][k] + 2 * x[k] + 2 * y[k] + 1 * z[k] for k in range(3)]
+    assert close(centre, (2, 2, 1)) and close(x, (0, 0, -1))
+    (plain,) = rows("Lot --> s(4, 4, 2) r(scopeOrigin, 0, 90, 0) i(cube)")
+    assert close(plain["origin"], (0, 0, 0)) and plain["axes"] == box["axes"]
+
+
+def test_a_bad_pivot_word_is_a_check_error():
+    with pytest.raises(bgr.BgrError, match="scopeCenter"):
+        bgr.load("Lot --> r(scopeMiddle, 0, 90, 0) i(cube)")

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from ..expressions import runtime_error
 from ..occlusion import note
+from ..shapes import DEFAULT_COLOR
 from ..surfaces import renamed
 
 
@@ -42,6 +43,12 @@ def color(app, shape, step, args) -> bool:
 
 def material(app, shape, step, args) -> bool:
     shape.material = renamed(shape.material, str(args[0]))  # set(material.*) values stay
+    return False
+
+
+def reset_material(app, shape, step, args) -> bool:
+    """CGA's resetMaterial(): the shape's material as a new shape's (interpreter/shapes.py)."""
+    shape.color, shape.material, shape.tex = DEFAULT_COLOR, None, None
     return False
 
 

@@ -324,6 +324,23 @@ def _thinned(ring, su: float, sv: float, tolerance: float):
     return tuple(out) if len(out) >= 3 else None
 
 
+def delete_holes(app, shape, step, args) -> bool:
+    """CGA's deleteHoles(): a 2D shape's polygons without their holes.  A solid keeps its
+    faces, which have none (boxes, roofs, assets: an OBJ polygon has no holes), except an
+    extrusion of a footprint with a courtyard, whose filled caps bgr cannot hold yet."""
+    geom = shape.geom
+    if isinstance(geom, Prism) and geom.polys != RECT and any(h for _, h in geom.polys):
+        raise runtime_error(
+            app.module,
+            step.pos,
+            "deleteHoles() of an extrusion with holes is not in bgr yet",
+            "delete the holes before extruding: deleteHoles() extrude(h)",
+        )
+    if isinstance(geom, Flat) and geom.polys != RECT and any(h for _, h in geom.polys):
+        shape.geom = Flat(geom.k, [(ext, ()) for ext, _ in geom.polys], geom.name)
+    return False
+
+
 def convexify(app, shape, step, args) -> bool:
     """CGA's convexify(maxLength): a 2D shape's polygons cut into convex parts (its comp(f)
     gives each as a face); cuts longer than ``maxLength`` metres are not made."""

@@ -55,12 +55,19 @@ def _rotate_axes(axes, axis: int, degrees: float):
 
 
 def rotate(app, shape, step, args) -> bool:
-    angles = _amounts(app, step, shape, args[:3])
+    """r(x, y, z) about the scope's origin; r(scopeCenter, x, y, z) about its centre, the
+    centre staying where it is (CGA's r with a pivot word)."""
+    pivot = args[0] if isinstance(args[0], str) else "scopeOrigin"
+    angles = _amounts(app, step, shape, args[1:4] if isinstance(args[0], str) else args[:3])
+    centre = shape.world([s / 2 for s in shape.size]) if pivot == "scopeCenter" else None
     axes = shape.axes
     for axis, deg in enumerate(angles):
         if deg:
             axes = _rotate_axes(axes, axis, deg)
     shape.axes = axes
+    if centre is not None:  # the turned scope's centre back where the centre was
+        moved = shape.world([s / 2 for s in shape.size])
+        shape.origin = [shape.origin[k] + centre[k] - moved[k] for k in range(3)]
     return False
 
 
