@@ -552,10 +552,12 @@ class Translator:
                 continue
             key_tree, body = e.children
             size = {"key_abs": "abs", "key_rel": "rel", "key_float": "float"}[key_tree.data]
-            if e.data == "keyed_whole" and kind != "split":
+            whole = e.data == "keyed_whole" and kind in ("comp", "comp:f")  # bgr's `=`
+            if e.data == "keyed_whole" and kind != "split" and not whole:
                 self.warn(
                     e.meta,
-                    "a '=' selector (all the faces as one shape) takes them one by one in bgr",
+                    "a '=' selector (all the parts as one shape) takes them one by one in bgr "
+                    "outside comp(f)",
                 )
             if kind == "split":
                 out.append(
@@ -568,11 +570,8 @@ class Translator:
                 )
                 continue
             for key in self.selectors(key_tree.children[0], kind, e.meta, named):
-                out.append(
-                    n.Entry(
-                        "abs", key, self.sequence_of(body.children, pos(body.meta)), pos=pos(e.meta)
-                    )
-                )
+                sequence = self.sequence_of(body.children, pos(body.meta))
+                out.append(n.Entry("abs", key, sequence, pos=pos(e.meta), combine=whole))
         return out
 
     def selectors(self, t, kind: str, meta, named: set[str]) -> list:

@@ -33,8 +33,9 @@ CGA: list[tuple[str, str, str, str]] = [
         "comp",
         PARTLY,
         "",
-        "faces, edges and vertices (`f`, `e`, `v`) with their selectors, roof edges included; "
-        "`fe`, `fv`, `g`, `m`, `h`, the `=` operator, street and object selectors not yet",
+        "faces, edges and vertices (`f`, `e`, `v`) with their selectors, roof edges included, "
+        "and comp(f)'s `=` (the faces as one shape); `fe`, `fv`, `g`, `m`, `h`, `=` in comp(e) "
+        "and comp(v), street and object selectors not yet",
     ),
     ("convexify", PARTLY, "", "2D shapes; a solid's faces not yet"),
     ("deleteHoles", PARTLY, "", "2D shapes and solids; an extrusion with a courtyard not yet"),

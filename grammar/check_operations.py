@@ -307,6 +307,13 @@ class OperationChecks(ExpressionChecks):
                 else:
                     self.block_entries(entry.entries, op, local, in_group=True)
                 continue
+            if entry.combine and not (op.block == "comp" and self.comp_kind == "f"):
+                self.error(
+                    entry.pos,
+                    f"'=' (the parts taken as one shape) belongs in comp(f) blocks, not in "
+                    f"'{op.name}'",
+                    "write ':' to take them one by one",
+                )
             if op.block == "split":
                 self.expr(entry.key, local, in_rule=True)
                 if isinstance(entry.key, (n.String, n.Bool)):

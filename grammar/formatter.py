@@ -417,7 +417,7 @@ class Formatter:
 
     def key(self, entry: n.Entry) -> str:
         prefix = {"abs": "", "rel": "'", "float": "~"}[entry.kind]
-        return f"{prefix}{_guarded(entry.key)}: "
+        return f"{prefix}{_guarded(entry.key)}{' = ' if entry.combine else ': '}"
 
     def block(self, entries, star: bool, pos: n.Pos, out: _Writer, force_inline: bool) -> None:
         inline = self.inline_block(entries, star)

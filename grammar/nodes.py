@@ -188,6 +188,7 @@ class Entry:
     key: Expr
     body: Sequence
     pos: Pos = _pos()
+    combine: bool = False  # `side = A`: comp(f)'s faces taken as one shape (CGA's `=`)
 
 
 @dataclass

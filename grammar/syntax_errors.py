@@ -111,8 +111,8 @@ def _hint(tok: Token | None, expected: set[str]) -> str | None:
         )
     if tok.type == "COLON" and "PERCENT" in expected:
         return "a stochastic choice is written '60%: A'"
-    if tok.type == "EQUAL" and "BINOP" in expected:
-        return "compare with '=='"
+    if tok.type == "EQUAL" and ("BINOP" in expected or expected == {"COLON"}):
+        return "compare with '=='"  # `case a = 1:` (the expression already ended at '=')
     return None
 
 

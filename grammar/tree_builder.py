@@ -308,6 +308,10 @@ class _TreeBuilder(Transformer):
         kind, key, start = c[0]
         return n.Entry(kind, key, c[1], pos=_span(start, c[1]))
 
+    def combined(self, c):
+        kind, key, start = c[0]
+        return n.Entry(kind, key, c[1], pos=_span(start, c[1]), combine=True)
+
     def group(self, c):
         return n.Group(c[1], pos=_span(c))
 

@@ -127,3 +127,18 @@ def test_horizontal_planes_cut_a_hip_roofs_tiles_at_the_hips(horizontal):
         assert got["tiles"] == pytest.approx(got["roof"], rel=0.03)
     else:  # the end slopes' and the sides' rows keep their full width
         assert got["tiles"] > got["roof"] * 1.3
+
+
+def test_planes_turned_off_and_on_again_still_cut():
+    """CGA keeps a shape's trim planes while trimming is off: the Parthenon turns it off for a
+    column's box and on for the capital, which the corner's plane then cuts."""
+    again = LEDGES.replace(
+        "Ledges --> s(", "Ledges --> set(trim.vertical, false) set(trim.vertical, true) s("
+    )
+    assert np.allclose(
+        bgr.derive(bgr.load(again), lot=(10.0, 10.0)).mesh.bounds,
+        bgr.derive(bgr.load(LEDGES), lot=(10.0, 10.0)).mesh.bounds,
+    )
+    off = LEDGES.replace("Ledges --> s(", "Ledges --> set(trim.vertical, false) s(")
+    bounds = bgr.derive(bgr.load(off), lot=(10.0, 10.0)).mesh.bounds
+    assert np.allclose(bounds[0][[0, 2]], [-2.0, -2.0], atol=1e-9)  # off: the ledges run past

@@ -26,6 +26,7 @@ from ..geometry.polygons import (
 from ..occlusion import note
 from ..shapes import Flat, Prism, Solid, cross, dot, normalise
 from ..terminals import UnitMesh
+from .combined import combined_faces
 from .extrude_faces import extrude_faces
 from .selection import check_budget, select, words
 from .trims import corner_planes, edge_planes
@@ -201,6 +202,12 @@ def comp_faces(app, shape, step) -> bool:
     # with trimming on, a solid's faces get planes where they meet (a 2D shape has one face)
     shared = edges(faces) if shape.trims is not None and len(faces) > 1 else []
     for entry, selector, chosen in select(app, step, answers):
+        if entry.combine and chosen:  # `=`: the faces taken, as one shape
+            taken = [_face_shape(shape, faces[i][0], faces[i][1]) for i in chosen]
+            piece = combined_faces(app, shape, faces, taken)
+            app.engine.count_shape(app.module, entry.pos)
+            app.piece(piece, entry.body, comp=(0, 1, 0.0, 0.0, selector))
+            continue
         for j, i in enumerate(chosen):
             rings, nrm, turns = faces[i]
             face = _face_shape(shape, rings, nrm)

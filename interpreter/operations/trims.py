@@ -59,10 +59,13 @@ class Trims:
 
 
 def switched(trims: Trims | None, which: str, on: bool) -> Trims | None:
-    """set(trim.vertical | trim.horizontal, on): None once both are off."""
+    """set(trim.vertical | trim.horizontal, on).  The planes stay with the shape while both
+    are off, as CGA's do (its Parthenon turns trimming off for a column's box and on again for
+    the capital, which the corner's plane then cuts); None once both are off and no plane is
+    left."""
     now = trims if trims is not None else Trims(False, False)
     now = replace(now, **{which: on})
-    return now if now.vertical or now.horizontal else None
+    return now if now.vertical or now.horizontal or now.planes else None
 
 
 def corner_planes(face: Shape, left: float, right: float) -> tuple:
