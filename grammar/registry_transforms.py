@@ -25,6 +25,15 @@ from .registry_kinds import (
 
 _MATRIX = tuple(Param(f"m{r}{c}", NUMBER) for r in range(3) for c in range(4))
 
+# rotate's and translate's arguments: a mode, a coordinate system and three numbers
+_IN_SYSTEM = _sig(
+    Param("mode", TRANSFORM_MODE),
+    Param("coordSystem", COORD_SYSTEM),
+    Param("x", NUMBER),
+    Param("y", NUMBER),
+    Param("z", NUMBER),
+)
+
 TRANSFORMS: list[Op] = [
     # -- transforms --------------------------------------------------------------------
     Op(
@@ -53,13 +62,7 @@ TRANSFORMS: list[Op] = [
     Op(
         "translate",
         "transforms",
-        _sig(
-            Param("mode", TRANSFORM_MODE),
-            Param("coordSystem", COORD_SYSTEM),
-            Param("x", NUMBER),
-            Param("y", NUMBER),
-            Param("z", NUMBER),
-        ),
+        _IN_SYSTEM,
         "CGA's translate: `rel` moves the scope by (x, y, z) metres along the axes of "
         "`coordSystem`, `abs` puts its origin at the point (x, y, z) of that system. `scope` is "
         "the shape's own scope (`translate(rel, scope, ...)` is `t`), `world` the axes the "
@@ -70,13 +73,7 @@ TRANSFORMS: list[Op] = [
     Op(
         "rotate",
         "transforms",
-        _sig(
-            Param("mode", TRANSFORM_MODE),
-            Param("coordSystem", COORD_SYSTEM),
-            Param("x", NUMBER),
-            Param("y", NUMBER),
-            Param("z", NUMBER),
-        ),
+        _IN_SYSTEM,
         "CGA's rotate, about the scope origin, in degrees, x then y then z: `rel` turns the "
         "scope by those angles about the axes of `coordSystem` (`rotate(rel, scope, ...)` is "
         "`r`), `abs` sets its orientation to those angles from that system's (`rotate(abs, "

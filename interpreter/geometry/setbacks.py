@@ -39,49 +39,24 @@ def edge_kinds(polys, su: float, sv: float, p: int, q: int) -> list[tuple[tuple,
 
 def strips(polys, su: float, sv: float, edges: list[tuple], distance) -> tuple:
     """(the strip of each edge, in metric polygons, in the edges' order; the remainder).
-    ``distance`` is one for all edges, or a list of one per edge (setbackPerEdge)."""
-    if isinstance(distance, list):
-        return _strips_each(polys, su, sv, edges, distance)
+    ``distance`` is one for all edges, or a list of one per edge (setbackPerEdge): each strip
+    as wide as its own distance (and as far past its ends), the corner two strips share going
+    to the edge that comes first; an edge of distance 0 has no strip."""
+    distances = distance if isinstance(distance, list) else [distance] * len(edges)
     whole = to_shapely(metric(polys, su, sv))
     taken = shapely.Polygon()
     parts = []
-    for a, b in edges if distance > 0 else []:
-        length = math.hypot(b[0] - a[0], b[1] - a[1])
-        tx, ty = (b[0] - a[0]) / length, (b[1] - a[1]) / length
-        ix, iy = -ty, tx  # inward
-        s = (a[0] - tx * distance, a[1] - ty * distance)
-        e = (b[0] + tx * distance, b[1] + ty * distance)
-        band = Polygon(
-            [s, e, (e[0] + ix * distance, e[1] + iy * distance),
-             (s[0] + ix * distance, s[1] + iy * distance)]
-        )  # fmt: skip
-        piece = whole.intersection(band).difference(taken)
-        taken = taken.union(piece)
-        parts.append(from_shapely(piece))
-    if distance <= 0:  # nothing is set back: no strips, the whole shape remains
-        parts = [[] for _ in edges]
-    return parts, from_shapely(whole.difference(taken))
-
-
-def _strips_each(polys, su: float, sv: float, edges: list[tuple], distances: list) -> tuple:
-    """strips() with a distance per edge: each strip as wide as its own distance (and as far
-    past its ends, as strips() goes), the corner two strips share going to the edge that comes
-    first; an edge of distance 0 has no strip.  Equal distances give what strips() gives."""
-    whole = to_shapely(metric(polys, su, sv))
-    taken = shapely.Polygon()
-    parts = []
-    for (a, b), distance in zip(edges, distances, strict=True):
-        if distance <= 0:
+    for (a, b), d in zip(edges, distances, strict=True):
+        if d <= 0:
             parts.append([])
             continue
         length = math.hypot(b[0] - a[0], b[1] - a[1])
         tx, ty = (b[0] - a[0]) / length, (b[1] - a[1]) / length
         ix, iy = -ty, tx  # inward
-        s = (a[0] - tx * distance, a[1] - ty * distance)  # past the ends as setback(d) goes
-        e = (b[0] + tx * distance, b[1] + ty * distance)
+        s = (a[0] - tx * d, a[1] - ty * d)
+        e = (b[0] + tx * d, b[1] + ty * d)
         band = Polygon(
-            [s, e, (e[0] + ix * distance, e[1] + iy * distance),
-             (s[0] + ix * distance, s[1] + iy * distance)]
+            [s, e, (e[0] + ix * d, e[1] + iy * d), (s[0] + ix * d, s[1] + iy * d)]
         )  # fmt: skip
         piece = whole.intersection(band).difference(taken)
         taken = taken.union(piece)
