@@ -30,18 +30,13 @@ from ..grammar.errors import Diagnostic, source_line
 from ..grammar.registry import (
     BUILTIN_NAMES,
     BUILTINS,
-    COMP_INDEX_CALLS,
-    COMP_SELECTORS,
-    EDGE_SELECTORS,
-    INNER_SELECTORS,
     KEYWORDS,
     OPERATIONS,
-    SETBACK_SELECTORS,
-    VERTEX_SELECTORS,
 )
 from . import media, overrides
 from . import operations as ops
-from .expressions import Expressions, bare_word, dotted, pos, unquote
+from .expressions import Expressions, dotted, pos, unquote
+from .selectors import selectors
 from .start import At, prepend_to_start, shape_attrs
 
 EMPTY = "t"  # a step that changes nothing: a sequence CGA leaves empty keeps its shape as a leaf
@@ -575,39 +570,7 @@ class Translator:
         return out
 
     def selectors(self, t, kind: str, meta, named: set[str]) -> list:
-        word = bare_word(t)
-        if kind == "offset":
-            words = ["inside", "border"] if word == "all" else [word]
-            if word not in ("inside", "border", "all"):
-                self.warn(meta, f"selector '{word}' after offset() is not in bgr; left out")
-                return []
-            keys = [w for w in words if w is not None and w not in named]
-            named.update(keys)
-            return [n.Name(w) for w in keys]
-        if kind == "innerRectangle":
-            if word in INNER_SELECTORS:
-                return [n.Name(word)]
-            self.warn(meta, f"innerRectangle selector '{word or 'this'}' is not in bgr; left out")
-            return []
-        if kind == "setback":
-            if word in SETBACK_SELECTORS:
-                return [n.Name(word)]
-            self.warn(meta, f"setback selector '{word or 'this'}' is not in bgr yet; left out")
-            return []
-        comp_kind = kind.partition(":")[2] or "f"  # "comp:e": the block of a comp(e)
-        allowed = {"e": EDGE_SELECTORS, "v": VERTEX_SELECTORS}.get(comp_kind, COMP_SELECTORS)
-        if word in allowed:
-            return [n.Name(word)]
-        if isinstance(t, Tree) and t.data == "number":
-            index = n.Number(float(str(t.children[0])))
-            return [n.Call(COMP_INDEX_CALLS[comp_kind], [index])]
-        parts = {"f": "faces", "e": "edges", "v": "vertices"}[comp_kind]
-        self.warn(
-            meta,
-            f"comp({comp_kind}) selector '{word or 'this'}' is not in bgr yet; its {parts} are "
-            "left out",
-        )
-        return []
+        return selectors(self, t, kind, meta, named)
 
 
 def _names(t) -> list[str]:

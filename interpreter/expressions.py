@@ -21,6 +21,7 @@ from . import arrays, string_lists
 from .context import Context as Context  # importable from here, as before
 from .context import RuleRef as RuleRef
 from .randomness import Stream, child_hash, name_hash, root_hash
+from .string_lists import as_text, number_text
 
 Value = Any
 Compiled = Callable[["Context"], Value]
@@ -74,31 +75,7 @@ def _show(value) -> str:
     return repr(value)  # numbers, and RuleRef: "the rule 'Arched'"
 
 
-def number_text(text: str) -> float | None:
-    """A string that spells a finite number, as that number; None otherwise."""
-    try:
-        value = float(text)
-    except ValueError:
-        return None
-    return value if math.isfinite(value) else None
-
-
 _TEXT = string_lists.TEXT  # len, count, find, substring, and the string lists'
-
-
-def as_text(value) -> str | None:
-    """CGA's str(): a string as it is, true/false, a number to 10 significant digits without a
-    trailing ".0" (str(1.69) is "1.69", str(2.0) "2"), an array as ``(3)[1,2,3]``; None for
-    what has no text (a rule)."""
-    if isinstance(value, str):
-        return value
-    if isinstance(value, bool):
-        return "true" if value else "false"
-    if isinstance(value, (int, float)):
-        return format(value, ".10g")
-    if isinstance(value, tuple):  # an array, as CityEngine prints one: (3)[1,2,3]
-        return f"({len(value)})[{','.join(str(as_text(v)) for v in value)}]"
-    return None
 
 
 _ARITH = {

@@ -1,5 +1,5 @@
-"""CGA's string functions (``len``, ``count``, ``find``, ``substring``) and its string lists:
-several strings in one, each followed by a semicolon (``"a;b;c;"``), with the functions of
+"""CGA's string functions (``len``, ``count``, ``find``, ``substring``, ``str``) and its string
+lists: several strings in one, each followed by a semicolon (``"a;b;c;"``), with the functions of
 CGA's utility library that read and build them (``listItem``, ``listSize``, ``listRandom``...).
 A string list is a string, not an array (arrays.py), so it travels through attrs, parameters
 and ``+`` like any other string.  A last item without its semicolon is read as an item, as the
@@ -7,6 +7,8 @@ functions CityEngine ships do.
 """
 
 from __future__ import annotations
+
+import math
 
 
 def items(text: str) -> list[str]:
@@ -80,3 +82,27 @@ TEXT = {
     "substring": (_substring, (str, float, float)),
     **FUNCTIONS,  # listItem, listSize ...: the string lists
 }
+
+
+def number_text(text: str) -> float | None:
+    """A string that spells a finite number, as that number; None otherwise."""
+    try:
+        value = float(text)
+    except ValueError:
+        return None
+    return value if math.isfinite(value) else None
+
+
+def as_text(value) -> str | None:
+    """CGA's str(): a string as it is, true/false, a number to 10 significant digits without a
+    trailing ".0" (str(1.69) is "1.69", str(2.0) "2"), an array as ``(3)[1,2,3]``; None for
+    what has no text (a rule)."""
+    if isinstance(value, str):
+        return value
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, (int, float)):
+        return format(value, ".10g")
+    if isinstance(value, tuple):  # an array, as CityEngine prints one: (3)[1,2,3]
+        return f"({len(value)})[{','.join(str(as_text(v)) for v in value)}]"
+    return None
