@@ -158,7 +158,7 @@ CGA: list[tuple[str, str, str, str]] = [
     ("geometry.nHoles", SAME, "", "with or without brackets"),
     ("geometry.nVertices", SAME, "", "with or without brackets"),
     ("geometry.volume", SAME, "", "with or without brackets"),
-    ("inside", PARTLY, "", "occlusion queries within the lot (intra, all); inter answers false"),
+    ("inside", SAME, "", ""),
     ("isinf", SAME, "", ""),
     ("isnan", SAME, "", ""),
     ("len", SAME, "", ""),
@@ -176,7 +176,7 @@ CGA: list[tuple[str, str, str, str]] = [
     ("log10", SAME, "", ""),
     ("max", SAME, "", ""),
     ("min", SAME, "", ""),
-    ("overlaps", PARTLY, "", "occlusion queries within the lot (intra, all); inter answers false"),
+    ("overlaps", SAME, "", ""),
     ("p", SAME, "", "or a stochastic rule: `30%: A | else: B`"),
     ("pow", DIFFERENT, "a ** b", ""),
     ("rand", SAME, "", ""),
@@ -194,7 +194,7 @@ CGA: list[tuple[str, str, str, str]] = [
     ("str", SAME, "", "and `+` joining a string with a number"),
     ("substring", SAME, "", ""),
     ("tan", SAME, "", ""),
-    ("touches", PARTLY, "", "occlusion queries within the lot (intra, all); inter answers false"),
+    ("touches", SAME, "", ""),
     # ---- other words -----------------------------------------------------------------------
     (
         "@Range, @Enum, @Group, ... (annotations)",

@@ -176,9 +176,9 @@ BUILTINS: dict[str, Builtin] = {
                 2,
                 f"{name}(target, label)",
                 f"CGA's occlusion query: true when the shape's geometry {what} the closed "
-                "geometry of another shape of the same lot (`intra` or `all`, the default; "
-                "`inter`, other lots, is not taken: false), or only of shapes that "
-                "`label(label)` named; tested against the lot derived once with every query "
+                "geometry of another shape: of the same lot (`intra`), of the lots within "
+                "1 m of it (`inter`) or both (`all`, the default); or only of shapes that "
+                "`label(label)` named; tested against the lots derived once with every query "
                 "false (see language.md).",
             )
             for name, what in (

@@ -29,9 +29,11 @@ import multiprocessing
 import os
 import uuid
 from collections import deque
-from collections.abc import Callable, Iterable, Iterator
-from concurrent.futures import Future
+from collections.abc import Callable, Generator, Iterable, Iterator
 from dataclasses import dataclass, field, replace
+from typing import Any
+
+import numpy as np
 
 from bgr.grammar.checker import Grammar
 from bgr.grammar.errors import BgrError, Diagnostic, Warnings
@@ -40,7 +42,14 @@ from bgr.grammar.parser import no_gc
 from .engine import Engine
 from .limits import default_max_memory, memory_in_use
 from .lots import Lot, attr_overrides
-from .occlusion import first_pass, uses_occlusion
+from .occlusion import (
+    Occluder,
+    Occluders,
+    first_pass,
+    lot_bounds,
+    neighbourhoods,
+    uses_occlusion,
+)
 from .shared import forget, share
 from .terminals import TerminalTable
 from .workers import Pool
@@ -117,35 +126,21 @@ def derive_lot(
     shapes: int = 0,
     triangles: int = 0,
     cache: dict | None = None,
+    occluders: Occluders | None = None,
 ) -> LotResult:
     """Derive one lot; ``shapes`` and ``triangles`` are the run's counts so far (the budgets
-    are the run's).  A BgrError is returned in the result, naming the lot, not raised."""
+    are the run's); ``occluders``: the lot's own and its neighbours' occluders when the run
+    found them beforehand (:func:`lot_occluders`), else a grammar that asks an occlusion
+    query derives the lot twice here.  A BgrError is returned in the result, naming the lot,
+    not raised."""
     name = lot_name(lot, index, job.several)
     warnings = Warnings(job.strict)
-    max_memory = job.max_memory if job.max_memory is not None else default_max_memory()
     try:
-        overrides = dict(job.attrs)
-        overrides.update(attr_overrides(lot, job.values, warnings))
-
-        def make_engine(warnings: Warnings) -> Engine:
-            made = Engine(
-                job.grammar,
-                job.seed,
-                overrides,
-                job.max_depth,
-                job.max_shapes,
-                lot_index=index,
-                warnings=warnings,
-                lot_name=name,
-                max_triangles=job.max_triangles,
-                max_memory=max_memory,
-                memory_base=memory_base(job),
-            )
-            made.shapes, made.triangles = shapes, triangles
-            return made
-
+        make_engine = _engine_maker(job, index, lot, warnings, shapes, triangles)
         engine = make_engine(warnings)
-        if uses_occlusion(job.grammar):  # derived once with every query false (occlusion.py)
+        if occluders is not None:
+            engine.occlusion = occluders
+        elif uses_occlusion(job.grammar):  # derived once with every query false (occlusion.py)
             engine.occlusion = first_pass(
                 lambda: make_engine(Warnings()), lot.shape.copy(), job.start, index, job.several
             )
@@ -192,6 +187,50 @@ def derive_lot(
     )
 
 
+def _engine_maker(
+    job: Job, index: int, lot: Lot, warnings: Warnings, shapes: int = 0, triangles: int = 0
+) -> Callable[[Warnings], Engine]:
+    """A function making the lot's engines (each with its own warnings): the run's attrs and
+    the lot's overrides of them (read now, their warnings into ``warnings``), the budgets
+    counted from ``shapes`` and ``triangles``."""
+    max_memory = job.max_memory if job.max_memory is not None else default_max_memory()
+    overrides = dict(job.attrs)
+    overrides.update(attr_overrides(lot, job.values, warnings))
+    name = lot_name(lot, index, job.several)
+
+    def make_engine(warnings: Warnings) -> Engine:
+        made = Engine(
+            job.grammar,
+            job.seed,
+            overrides,
+            job.max_depth,
+            job.max_shapes,
+            lot_index=index,
+            warnings=warnings,
+            lot_name=name,
+            max_triangles=job.max_triangles,
+            max_memory=max_memory,
+            memory_base=memory_base(job),
+        )
+        made.shapes, made.triangles = shapes, triangles
+        return made
+
+    return make_engine
+
+
+def lot_occluders(job: Job, index: int, lot: Lot) -> list[Occluder]:
+    """The occluders of the lot's first pass (every query false; occlusion.py), for the
+    lots around it; none when that pass fails (the lot's own derivation reports why)."""
+    try:
+        make_engine = _engine_maker(job, index, lot, Warnings())
+        found = first_pass(
+            lambda: make_engine(Warnings()), lot.shape.copy(), job.start, index, job.several
+        )
+    except BgrError:
+        return []
+    return found.items
+
+
 def naming(error: BgrError, name: str) -> BgrError:
     """The error with the lot it happened on named at the start of each message (the location
     stays the grammar's ``file:line:col``); unchanged when the run has one unnamed lot."""
@@ -212,6 +251,7 @@ def derive_lots(
     dask: str | None = None,
     batch_size: int | None = None,
     count: int | None = None,
+    first_passes: Callable[[int], None] | None = None,
 ) -> Iterator[LotResult]:
     """Every lot's :class:`LotResult`, in lot order; the first lot that fails raises its
     BgrError (after the results before it), as a serial run would.
@@ -224,7 +264,13 @@ def derive_lots(
         raise BgrError(f"--workers must be at least 1, got {workers}")
     if count is None and hasattr(lots, "__len__"):
         count = len(lots)  # type: ignore[arg-type]
-    numbered = enumerate(lots)
+    occluders: Iterator[Occluders | None] = itertools.repeat(None)
+    if uses_occlusion(job.grammar) and job.several:
+        # inter occlusion: every lot's first pass before any lot's second (occlusion.py)
+        lots = list(lots)
+        count = len(lots)
+        occluders = _around(job, lots, workers, dask, batch_size, first_passes)
+    numbered = zip(itertools.count(), lots, occluders)
     if dask is None and workers == 1:
         yield from _serial(job, numbered)
         return
@@ -232,9 +278,9 @@ def derive_lots(
     batches = iter(lambda: list(itertools.islice(numbered, size)), [])
     window = 4 * workers
     if dask is not None:
-        results = _on_dask(job, batches, dask, workers, window)
+        results = _on_dask(job, batches, dask, workers, window, derive_batch)
     else:
-        results = _on_pool(job, batches, workers, window)
+        results = _on_pool(job, batches, workers, window, _pool_batch)
     shapes = triangles = 0
     try:
         for result in results:
@@ -245,10 +291,46 @@ def derive_lots(
         results.close()  # a failed lot stops the workers now, not when the generator is collected
 
 
+def _around(
+    job: Job,
+    lots: list[Lot],
+    workers: int,
+    dask: str | None,
+    batch_size: int | None,
+    progress: Callable[[int], None] | None,
+) -> Iterator[Occluders]:
+    """Each lot's occluders for its second pass: its own first pass's and those of the lots
+    within NEIGHBOURHOOD of it (``inter``), the first passes derived like the lots themselves
+    (here, on the pool or on Dask); ``progress(n)`` is told of each lot's first pass."""
+    numbered: Iterator[tuple[int, Lot, Occluders | None]]
+    numbered = zip(itertools.count(), lots, itertools.repeat(None))
+    if dask is None and workers == 1:
+        found = []
+        for index, lot, _ in numbered:
+            found.append(lot_occluders(job, index, lot))
+            if progress is not None:
+                progress(1)
+    else:
+        size = batch_size or _batch_size(len(lots), workers)
+        batches = iter(lambda: list(itertools.islice(numbered, size)), [])
+        if dask is not None:
+            parts = _on_dask(job, batches, dask, workers, 4 * workers, occluders_batch)
+        else:
+            parts = _on_pool(job, batches, workers, 4 * workers, _pool_occluders)
+        found = []
+        for part in parts:
+            found.append(part)
+            if progress is not None:
+                progress(1)
+    near = neighbourhoods(np.array([lot_bounds(lot.shape) for lot in lots]))
+    for index, own in enumerate(found):
+        yield Occluders(own, [item for other in near[index] for item in found[other]])
+
+
 COLLECT_EVERY = 256  # lots between two collections in a serial run (see _serial)
 
 
-def _serial(job: Job, numbered: Iterator[tuple[int, Lot]]) -> Iterator[LotResult]:
+def _serial(job: Job, numbered: Iterator[tuple[int, Lot, Occluders | None]]) -> Iterator[LotResult]:
     """The lots derived one after another in this process, the cyclic collector paused from
     the first to the last (between two lots too, while the caller writes one: the lots make
     no cycles, tests/test_engine_release.py, and each time the collector was switched back on
@@ -259,13 +341,21 @@ def _serial(job: Job, numbered: Iterator[tuple[int, Lot]]) -> Iterator[LotResult
     enabled = gc.isenabled()
     gc.disable()
     try:
-        for index, lot in numbered:
+        for index, lot, occluders in numbered:
             if index % COLLECT_EVERY == COLLECT_EVERY - 1:
                 gc.collect()
             if len(cache) > CACHE_ENTRIES:
                 forget(cache)
                 cache.clear()
-            result = derive_lot(job, index, lot, shapes=shapes, triangles=triangles, cache=cache)
+            result = derive_lot(
+                job,
+                index,
+                lot,
+                shapes=shapes,
+                triangles=triangles,
+                cache=cache,
+                occluders=occluders,
+            )
             if result.error is not None:
                 raise result.error
             if not job.per_lot:
@@ -323,25 +413,39 @@ def _start_worker(job: Job) -> None:
     _JOB = job
 
 
-def _pool_batch(batch: list[tuple[int, Lot]]) -> list[LotResult]:
+# a batch: (index, lot, the lot's occluders or None) for each of its lots
+Batch = list[tuple[int, Lot, "Occluders | None"]]
+
+
+def _pool_batch(batch: Batch) -> list[LotResult]:
     assert _JOB is not None, "the pool's initializer did not run"
     return derive_batch(_JOB, batch)
 
 
-def derive_batch(job: Job, batch: list[tuple[int, Lot]]) -> list[LotResult]:
-    """Derive a batch of (index, lot) pairs in a worker; a failed lot ends the batch (the lots
-    after it would not be written)."""
+def _pool_occluders(batch: Batch) -> list[list[Occluder]]:
+    assert _JOB is not None, "the pool's initializer did not run"
+    return occluders_batch(_JOB, batch)
+
+
+def occluders_batch(job: Job, batch: Batch) -> list[list[Occluder]]:
+    """The first-pass occluders of each lot of a batch, in a worker (:func:`lot_occluders`)."""
+    return [lot_occluders(job, index, lot) for index, lot, _ in batch]
+
+
+def derive_batch(job: Job, batch: Batch) -> list[LotResult]:
+    """Derive a batch of lots in a worker; a failed lot ends the batch (the lots after it
+    would not be written)."""
     global _CACHE_OF
     if job.token != _CACHE_OF:  # a cache's keys are ids of one grammar's nodes
         forget(_CACHE)
         _CACHE.clear()
         _CACHE_OF = job.token
     out = []
-    for index, lot in batch:
+    for index, lot, occluders in batch:
         if len(_CACHE) > CACHE_ENTRIES:
             forget(_CACHE)
             _CACHE.clear()
-        result = derive_lot(job, index, lot, cache=_CACHE)
+        result = derive_lot(job, index, lot, cache=_CACHE, occluders=occluders)
         out.append(result)
         if result.error is not None:
             break
@@ -355,22 +459,24 @@ def _context():
     return multiprocessing.get_context("forkserver" if "forkserver" in methods else "spawn")
 
 
-def _on_pool(job: Job, batches: Iterator[list], workers: int, window: int) -> Iterator[LotResult]:
+def _on_pool(
+    job: Job, batches: Iterator[Batch], workers: int, window: int, function: Callable
+) -> Generator:
+    """``function(batch)`` (a module-level function of one batch) of every batch, on a local
+    pool whose workers hold the job; the items of each batch's result, in order."""
     pool = Pool(workers, _context(), _start_worker, (job,))
-    for results in pool.ordered(_pool_batch, batches, window, describe=_lots_of):
+    for results in pool.ordered(function, batches, window, describe=_lots_of):
         yield from results
 
 
-def _lots_of(batch: list[tuple[int, Lot]]) -> str:
+def _lots_of(batch: Batch) -> str:
     """How a dead worker's message names the lots it was deriving."""
     first, last = batch[0][0], batch[-1][0]
     name = lot_name(batch[0][1], first, True)
     return name if first == last else f"lots {first}-{last} (from {name})"
 
 
-def _in_order(
-    submit: Callable[[list], Future], batches: Iterator[list], window: int
-) -> Iterator[LotResult]:
+def _in_order(submit: Callable[[Batch], Any], batches: Iterator[Batch], window: int) -> Iterator:
     """Submit batches, at most ``window`` in flight, and yield their results in order."""
     pending: deque = deque()
     for batch in batches:
@@ -386,8 +492,10 @@ def _in_order(
 
 
 def _on_dask(
-    job: Job, batches: Iterator[list], address: str, workers: int, window: int
-) -> Iterator[LotResult]:
+    job: Job, batches: Iterator[Batch], address: str, workers: int, window: int, function: Callable
+) -> Generator:
+    """``function(job, batch)`` of every batch on a Dask cluster; the items of each batch's
+    result, in order."""
     try:
         from distributed import Client, LocalCluster
     except ImportError:
@@ -424,7 +532,7 @@ def _on_dask(
     try:
         shared = client.scatter(job, broadcast=True)
         yield from _in_order(
-            lambda batch: client.submit(derive_batch, shared, batch, pure=False), batches, window
+            lambda batch: client.submit(function, shared, batch, pure=False), batches, window
         )
     finally:
         client.close()

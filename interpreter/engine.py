@@ -15,6 +15,7 @@ import gc
 import math
 import os
 from dataclasses import replace
+from typing import Any
 
 import numpy as np
 
@@ -105,7 +106,7 @@ class Engine:
         self._flat_ids: dict[tuple, int] = {}
         self._bare_ids: set[int] = set()  # the meshes of bare shapes (comp(e), comp(v))
         self.solid_slabs: dict[tuple, object] = {}  # (mesh, axis, lo, hi) -> a split's piece
-        self.occlusion = None  # occlusion.Recorder or .Occluders when the grammar asks them
+        self.occlusion: Any = None  # occlusion.Recorder or .Occluders when the grammar asks them
         # CGA's object coordinate system (rotate, translate): the lot's scope as the start rule
         # receives it, set by derive()
         self.object_frame: tuple = (

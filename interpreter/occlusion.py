@@ -20,8 +20,13 @@ the query's geometry (its corners, edge midpoints and triangle centres) against 
   occluder's strictly inside it;
 * touches: overlaps, or a triangle centre of either lies on the other's surface.
 
-``intra`` and ``all`` (the default) test the lot's own shapes; ``inter``, other lots, is not
-taken (lots derive apart, on several processes): it answers false.
+``intra`` tests the lot's own shapes, ``inter`` those of the lots around it, ``all`` (the
+default) both.  The lots around a lot are those whose bounding boxes come within
+:data:`NEIGHBOURHOOD` (1 m, CityEngine's default) of its own; their occluders are the closed
+shapes of *their* first passes, so a run of several lots whose grammar asks a query first
+derives every lot once with every query false, then each again against its own first pass
+and its neighbours' (:func:`bgr.interpreter.batch.derive_lots`): what a lot makes never
+depends on which process derived it, or on the order of the lots.
 """
 
 from __future__ import annotations
@@ -111,12 +116,22 @@ class Recorder:
 
 
 class Occluders:
-    """The second pass: each query tested against the first pass's occluders."""
+    """The second pass: each query tested against the first pass's occluders, the lot's own
+    (``items``, for ``intra``) and those of the lots around it (``neighbours``, ``inter``)."""
 
     testing = True
 
-    def __init__(self, items: list[Occluder]) -> None:
+    def __init__(self, items: list[Occluder], neighbours: list[Occluder] | None = None) -> None:
         self.items = items
+        self.neighbours = neighbours or []
+
+    def of(self, target: str) -> list[Occluder]:
+        """The occluders a query with this target tests."""
+        if target == "intra":
+            return self.items
+        if target == "inter":
+            return self.neighbours
+        return self.items + self.neighbours
 
 
 def note(app, shape, label: str | None = None, first: int | None = None) -> None:
@@ -202,7 +217,7 @@ def _where(points: np.ndarray, triangles: np.ndarray, eps: float) -> np.ndarray:
 def query(ctx, name: str, target: str, label) -> bool:
     """inside, overlaps or touches (``name``) of the context's shape (see the docstring)."""
     occlusion = ctx.occlusion
-    if occlusion is None or not occlusion.testing or target == "inter":
+    if occlusion is None or not occlusion.testing:
         return False
     shape = ctx.shape
     mine = _world(shape, ctx.library)
@@ -214,7 +229,7 @@ def query(ctx, name: str, target: str, label) -> bool:
     scale = max(float(np.ptp(points, axis=0).max()), 1.0)
     eps = 1e-6 * scale
     closed = None
-    for other in occlusion.items:
+    for other in occlusion.of(target):
         if wanted is not None and other.label != wanted:
             continue
         if _related(other, shape.path):
@@ -254,3 +269,45 @@ def first_pass(make_engine, lot_shape, start, index: int, several: bool) -> Occl
         return recorder.finish(engine.table)
     finally:
         engine.release()
+
+
+# --------------------------------------------------------------------------------------------
+# the lots around a lot (inter)
+
+NEIGHBOURHOOD = 1.0  # metres between two lots' bounding boxes (CityEngine's default)
+
+
+def lot_bounds(shape) -> np.ndarray:
+    """(2, 3): the lowest and highest world corner of a lot's scope, the box its initial
+    shape lies in."""
+    corners = np.array([[i, j, k] for i in (0, 1) for j in (0, 1) for k in (0, 1)], float)
+    world = np.asarray(shape.origin, float) + (corners * np.asarray(shape.size, float)) @ (
+        np.asarray(shape.axes, float)
+    )
+    return np.stack([world.min(axis=0), world.max(axis=0)])
+
+
+def neighbourhoods(bounds: np.ndarray, distance: float = NEIGHBOURHOOD) -> list[list[int]]:
+    """For each box of ``bounds`` (N, 2, 3), the other boxes within ``distance`` of it, in
+    index order.  Candidates come from an R-tree of the ground-plane boxes (shapely's
+    STRtree), then the 3-D gap between the boxes decides."""
+    from shapely import STRtree, box
+
+    count = len(bounds)
+    if count < 2:
+        return [[] for _ in range(count)]
+    low, high = bounds[:, 0], bounds[:, 1]
+    tree = STRtree([box(lo[0], lo[2], hi[0], hi[2]) for lo, hi in zip(low, high, strict=True)])
+    near = [
+        box(lo[0] - distance, lo[2] - distance, hi[0] + distance, hi[2] + distance)
+        for lo, hi in zip(low, high, strict=True)
+    ]
+    mine, theirs = tree.query(near, predicate="intersects")
+    keep = mine != theirs
+    mine, theirs = mine[keep], theirs[keep]
+    gap = np.maximum(0.0, np.maximum(low[theirs] - high[mine], low[mine] - high[theirs]))
+    close = np.linalg.norm(gap, axis=1) <= distance
+    found: list[list[int]] = [[] for _ in range(count)]
+    for i, j in sorted(zip(mine[close].tolist(), theirs[close].tolist(), strict=True)):
+        found[i].append(j)
+    return found

@@ -174,7 +174,19 @@ def _derive(args, attrs, options, limits, workers, output, fmt, writer) -> int:
         ) as sink,
         _progress(len(lots), output) as bar,
     ):
-        for result in derive_lots(job, lots, workers=workers, dask=args.dask):
+
+        def first_pass(done: int) -> None:
+            """A grammar that asks occlusion queries derives every lot once first (its
+            occluders, for the lots around it): the bar counts that pass, then starts again."""
+            bar.set_description("first pass", refresh=False)
+            bar.update(done)
+            if bar.n >= len(lots):
+                bar.reset()
+                bar.set_description("deriving")
+
+        for result in derive_lots(
+            job, lots, workers=workers, dask=args.dask, first_passes=first_pass
+        ):
             show(read.before(lots[result.index]) + result.warnings, bar)
             for lot in result.table.lots:  # the grammar's print() calls, as CGA's console
                 for text in lot.get("prints", ()):
