@@ -37,7 +37,7 @@ CGA: list[tuple[str, str, str, str]] = [
         "and comp(f)'s `=` (the faces as one shape); `fe`, `fv`, `g`, `m`, `h`, `=` in comp(e) "
         "and comp(v), street and object selectors not yet",
     ),
-    ("convexify", PARTLY, "", "2D shapes; a solid's faces not yet"),
+    ("convexify", SAME, "", ""),
     ("deleteHoles", PARTLY, "", "2D shapes and solids; an extrusion with a courtyard not yet"),
     ("deleteUV", SAME, "", ""),
     (

@@ -167,8 +167,9 @@ TRANSFORMS: list[Op] = [
         "transforms",
         ((), (Param("maxLength", NUMBER),)),
         "Cut a 2D shape's polygons into convex parts (its comp(f) then gives each as a "
-        "face), as CGA's convexify; cuts longer than `maxLength` metres are not made, so a "
-        "part may stay concave.",
+        "face), as CGA's convexify; a solid keeps its geometry and its comp(f) cuts each "
+        "concave face so; cuts longer than `maxLength` metres are not made, so a part may "
+        "stay concave.",
         "convexify() comp(f) { all: Part }",
     ),
     Op(

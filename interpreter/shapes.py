@@ -32,12 +32,16 @@ class Prism:
     k: int
     polys: object
     name: str = "prism"
+    # convexify(maxLength) of the solid: comp(f) cuts its concave faces into convex parts,
+    # with cuts up to this length (math.inf: all); 0: not convexified
+    convex: float = 0.0
 
 
 @dataclass(frozen=True, slots=True)
 class Solid:
     mesh: int  # id in the derivation's MeshLibrary
     name: str  # what the terminal list's "geometry" says: cube, roof, an asset's name...
+    convex: float = 0.0  # as Prism's
 
 
 _new_shape = object.__new__

@@ -193,6 +193,41 @@ def test_convexify_cuts_a_concave_outline_into_convex_faces():
     assert box == 1
 
 
+def test_convexify_of_a_solid_cuts_its_concave_faces():
+    # a U-shaped mass: its caps come out of comp(f) as three convex parts each, the walls
+    # (rectangles) whole, the mesh itself unchanged
+    def faces(text):
+        return _derive(
+            "terminal Cap, Wall\nLot --> footprint(U, 0.3, 0.4) extrude(6) "
+            + text
+            + " comp(f) { top: Cap | bottom: Cap | side: Wall }",
+            lot=(20.0, 15.0),
+        )
+
+    plain, cut = faces(""), faces("convexify()")
+    assert list(plain.terminals.label).count("Cap") == 2
+    assert list(cut.terminals.label).count("Cap") == 6
+    assert list(cut.terminals.label).count("Wall") == list(plain.terminals.label).count("Wall")
+    assert cut.mesh.area == pytest.approx(plain.mesh.area)
+    flags = _derive(
+        "terminal F\nLot --> footprint(U, 0.3, 0.4) extrude(6) convexify() "
+        "comp(f) { all: label(str(geometry.isConcave())) F }",
+        lot=(20.0, 15.0),
+    )
+    assert len(flags) == 6 + 8 and set(flags.terminals.label) == {"false"}
+    # no cut is 5 m or shorter here: the caps stay whole; a box has nothing to cut
+    assert list(faces("convexify(5)").terminals.label).count("Cap") == 2
+    box = _derive("terminal F\nLot --> extrude(3) convexify() comp(f) { all: F }")
+    assert len(box) == 6
+    # a hip roof on an L: every face comp(f) gives is convex
+    roof = _derive(
+        "terminal F\nLot --> footprint(L, 0.4, 0.4) roof(hip, 30) convexify() "
+        "comp(f) { all: label(str(geometry.isConcave())) F }",
+        lot=(20.0, 15.0),
+    )
+    assert set(roof.terminals.label) == {"false"}
+
+
 def test_align_scope_to_geometry_of_a_solid_uses_its_faces():
     # CGA's roof-tile idiom on the roof itself: y along the largest slope's normal, x along
     # that slope's lowest edge (the eave); the roof stays where it was

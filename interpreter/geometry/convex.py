@@ -95,3 +95,30 @@ def _convex(ring: list[int], metres: np.ndarray) -> bool:
     edges = np.roll(pts, -1, axis=0) - pts
     turns = edges[:, 0] * np.roll(edges[:, 1], -1) - edges[:, 1] * np.roll(edges[:, 0], -1)
     return bool((turns >= -_EPS * max(1.0, float(np.abs(turns).max()))).all())
+
+
+def convex_faces(faces: list, max_length: float = math.inf) -> list:
+    """The faces of a solid (comp(f)'s ``(rings of 3D points, normal, turns)``) with each
+    concave one, or one with holes, cut into convex parts in its own plane: a convexified
+    solid's comp(f) gives each part as a face (its corner turns then 0)."""
+    out = []
+    for rings, normal, turns in faces:
+        n = np.asarray(normal, dtype=float)
+        ref = np.array([0.0, 1.0, 0.0]) if abs(n[1]) < 0.9 else np.array([1.0, 0.0, 0.0])
+        e1 = np.cross(ref, n)
+        e1 /= np.linalg.norm(e1)
+        e2 = np.cross(n, e1)
+        origin = np.asarray(rings[0][0], dtype=float)
+        flat = [(np.asarray(ring, dtype=float) - origin) @ np.stack([e1, e2]).T for ring in rings]
+        metres = flat[0]
+        if len(rings) == 1 and _convex(_ccw(list(range(len(metres))), metres), metres):
+            out.append((rings, normal, turns))
+            continue
+        # counter-clockwise in (e1, e2) seen from the normal's side, holes clockwise
+        parts = convex_parts(
+            [(tuple(map(tuple, flat[0])), tuple(map(tuple, flat[1:])))], 1, 1, max_length
+        )
+        for ring, _ in parts:
+            points = [list(origin + u * e1 + v * e2) for u, v in ring]
+            out.append(([points], normal, (0.0, 0.0)))
+    return out

@@ -9,6 +9,7 @@ import numpy as np
 import shapely
 
 from ..expressions import runtime_error
+from ..geometry.convex import convex_faces
 from ..geometry.edges import edges
 from ..geometry.frames import WORLD_UP, extrusion_axes, planar_faces, reframe_flat
 from ..geometry.meshes import PLANE_AXES
@@ -35,7 +36,14 @@ from .trims import corner_planes, edge_planes
 
 
 def faces_of(app, step, shape):
-    """Faces of a shape as (points in scope-local metres, outward normal in scope coordinates)."""
+    """Faces of a shape as (points in scope-local metres, outward normal in scope coordinates,
+    the turns at its bottom corners); a convexified solid's cut into convex parts."""
+    faces = _faces(app, step, shape)
+    limit = getattr(shape.geom, "convex", 0.0)
+    return convex_faces(faces, limit) if limit else faces
+
+
+def _faces(app, step, shape):
     geom = shape.geom
     if isinstance(geom, Solid) and geom.name == "cube":
         geom = Prism(1, RECT)

@@ -12,6 +12,7 @@ before; a prism turned about its own extrusion axis stays a prism; anything else
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 
 import numpy as np
 
@@ -343,20 +344,20 @@ def delete_holes(app, shape, step, args) -> bool:
 
 def convexify(app, shape, step, args) -> bool:
     """CGA's convexify(maxLength): a 2D shape's polygons cut into convex parts (its comp(f)
-    gives each as a face); cuts longer than ``maxLength`` metres are not made."""
+    gives each as a face), or a solid's concave faces (its comp(f) then gives their parts);
+    cuts longer than ``maxLength`` metres are not made."""
     geom = shape.geom
-    if not isinstance(geom, Flat):
-        raise runtime_error(
-            app.module,
-            step.pos,
-            "convexify() of a solid is not in bgr yet",
-            "convexify a 2D shape: a lot, or a face from comp(f)",
-        )
-    if geom.polys == RECT:
-        return False
     limit = args[0] if len(args) > 1 else math.inf
     if isinstance(limit, bool) or not isinstance(limit, (int, float)):
         raise runtime_error(app.module, step.pos, "convexify()'s maxLength is a number")
+    if limit <= 0:  # no cut is that short
+        return False
+    if not isinstance(geom, Flat):
+        # the solid's own faces stay; comp(f) cuts them (components.faces_of)
+        shape.geom = replace(geom, convex=float(limit))
+        return False
+    if geom.polys == RECT:
+        return False
     p, q = PLANE_AXES[geom.k]
     parts = convex_parts(geom.polys, shape.size[p], shape.size[q], float(limit))
     if parts:
