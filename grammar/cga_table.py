@@ -89,8 +89,8 @@ CGA: list[tuple[str, str, str, str]] = [
         PARTLY,
         "",
         "attrs; `trim.*`; `material.opacity`, `.metallic`, `.roughness`, `.specular.r/g/b`, "
-        "`.shininess`, `.reflectivity`; `set(material.name, v)` is `material(v)`; the other "
-        "shape attributes (`material.bumpValue`, `pivot.*`...) not yet",
+        "`.shininess`, `.reflectivity`, `.color.r/g/b`; `set(material.name, v)` is "
+        "`material(v)`; the other shape attributes (`material.bumpValue`, `pivot.*`...) not yet",
     ),  # fmt: skip
     (
         "setback",

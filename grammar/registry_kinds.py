@@ -84,7 +84,7 @@ COORD_SYSTEMS = ("scope", "pivot", "object", "world")
 # CGA's shape attributes set() may change besides a file's attrs: whether vertical and
 # horizontal trim planes cut (operations/trims.py), and the material's opacity, metallic,
 # roughness, specular colour and reflectivity (0..1) and shininess (0..128:
-# interpreter/surfaces.py)
+# interpreter/surfaces.py), and one channel of the shape's colour (0..1, as color()'s)
 SHAPE_ATTRIBUTES = (
     "trim.vertical",
     "trim.horizontal",
@@ -96,6 +96,9 @@ SHAPE_ATTRIBUTES = (
     "material.specular.b",
     "material.shininess",
     "material.reflectivity",
+    "material.color.r",
+    "material.color.g",
+    "material.color.b",
 )
 # kinds that take a number or one of these words
 NUMBER_OR_WORD = {

@@ -5,6 +5,7 @@ roughnessFactor) and OBJ's .mtl (d, Pm, Pr); a grammar that sets none writes wha
 import json
 import struct
 
+import numpy as np
 import pytest
 
 import bgr
@@ -134,3 +135,16 @@ def test_shininess_goes_to_128_and_no_further():
     assert ok.terminals.material[0].shininess == 128
     with pytest.raises(bgr.BgrError, match="takes a number from 0 to 128"):
         bgr.derive(bgr.load("Lot --> set(material.shininess, 129) A\nterminal A\n"), lot=(4, 4))
+
+
+def test_set_material_color_changes_one_channel_of_the_colour():
+    # CGA's set(material.color.r, v): the other channels stay as color() left them
+    src = """terminal A, B
+Lot --> [ color("#336699") set(material.color.r, 1) A ] [ set(material.color.g, 0.5) B ]
+"""
+    result = bgr.derive(bgr.load(src), lot=(4, 4))
+    colours = dict(zip(result.terminals.label, result.terminals.color, strict=True))
+    assert np.allclose(colours["A"], (1.0, 0x66 / 255, 0x99 / 255))
+    assert np.allclose(colours["B"], (0.8, 0.5, 0.8))  # from the default #cccccc
+    with pytest.raises(bgr.BgrError, match="takes a number from 0 to 1"):
+        bgr.derive(bgr.load("Lot --> set(material.color.b, 2) A\nterminal A\n"), lot=(4, 4))

@@ -26,6 +26,15 @@ def set_attr(app, shape, step, args) -> bool:
             f"set({name}, ...) takes a number, a string or true/false, not the rule "
             f"'{value.member}'",
         )
+    if name.startswith("material.color."):  # one channel of color(): r, g or b, 0..1
+        if isinstance(value, bool) or not isinstance(value, (int, float)) or not 0 <= value <= 1:
+            raise runtime_error(
+                app.module, step.pos, f"set({name}, ...) takes a number from 0 to 1, got {value!r}"
+            )
+        channels = list(shape.color)
+        channels["rgb".index(name[-1])] = float(value)
+        shape.color = tuple(channels)
+        return False
     if name.startswith("material."):  # 0..1, shininess 0..128 (interpreter/surfaces.py)
         attribute = name.split(".", 1)[1]
         largest = LARGEST.get(attribute, 1.0)
