@@ -77,6 +77,7 @@ _NUMERIC_KINDS = {
 # operations that move or stretch a shape's geometry with its scope: its texture projections and
 # coordinates follow (texturing.follow).  reverseNormals keeps the outline where it is.
 _MOVERS = frozenset({"t", "r", "s", "center", "matrix", "translate", "rotate"})
+_ARRAYS = frozenset({"set", "print"})  # operations that take an array as a value
 _NUMBER = (float, int)  # bool is neither: True.__class__ is bool
 EMIT = object()  # marks a children-list entry that is a finished terminal, kept in order
 _NAME_HASHES: dict[str, int] = {}
@@ -278,7 +279,8 @@ class Application:
             for kind, value, fn, _ in plan
         ]
         for i, value in enumerate(out):
-            number = value[1] if value.__class__ is tuple else value
+            # a relative size is ("rel", f); any other tuple is an array
+            number = value[1] if plan[i][0] == 2 else value
             if number.__class__ in _NUMBER:
                 if not -MAX_COORDINATE <= number <= MAX_COORDINATE:
                     self.out_of_range(step, i, number)
@@ -292,6 +294,13 @@ class Application:
                     f"{step.name}() needs a finite number, got {what} (argument {i + 1})",
                     "a string or an array where a number goes: an attr set to one, or a "
                     "conditional whose branches give one?",
+                )
+            elif number.__class__ is tuple and plan[i][0] == 1 and step.name not in _ARRAYS:
+                raise runtime_error(
+                    self.module,
+                    step.pos,
+                    f"{step.name}() takes one value, got an array (argument {i + 1})",
+                    "pick an item with a[i]",
                 )
         out.append(received)
         return out

@@ -64,6 +64,26 @@ def test_an_array_where_a_number_goes_is_an_error_not_a_crash():
         bgr.derive(bgr.load("attr h = [3, 4]\nLot --> extrude(h) A\nterminal A\n"), lot=(4, 4))
 
 
+@pytest.mark.parametrize(
+    "step, message",
+    [
+        # an array is a tuple, as a relative size is ("rel", f): neither may pass for the other
+        ("setback(h) { all: A | remainder: A }", r"setback\(\) needs a finite number"),
+        ("s(h, 1, 1)", r"s\(\) needs a finite number"),
+        ("s('h, 1, 1)", r"s\(\) needs a finite number"),
+        ("roof(gable, h)", r"roof\(\) needs a finite number"),
+        ("i(cube) r(0, h, 0)", r"r\(\) needs a finite number"),
+        ("color(h)", r"color\(\) takes one value, got an array"),
+        ("label(h)", r"label\(\) takes one value, got an array"),
+        ("material(h)", r"material\(\) takes one value, got an array"),
+    ],
+)
+def test_an_array_is_no_operations_single_value(step, message):
+    src = f"attr h = [3, 4]\nLot --> {step} A\nterminal A\n"
+    with pytest.raises(bgr.BgrError, match=message):
+        bgr.derive(bgr.load(src), lot=(4, 4))
+
+
 def test_arrays_pick_sizes_and_reach_the_terminal_lists_attrs():
     src = """attr heights = [3, 4.5, 6]
 terminal A
