@@ -66,21 +66,22 @@ def scale(buildings: int, city: Path) -> None:
         seconds, peak, err = run(["infer", str(city), "-o", "city.bgr", "--no-progress"], tmp)
         found = re.search(
             r"(\d+) objects, (\d+) components, (\d+) types at level 0 "
-            r"\((\d+) footprints extruded\), (\d+) rules",
+            r"\((\d+) footprints extruded(?:, (\d+) houses? roofed)?\), (\d+) rules",
             err,
         )
         lines = (Path(tmp) / "city.bgr").read_text().count("\n")
+        size = sum(p.stat().st_size for p in Path(tmp).rglob("*") if p.is_file())
     print(f"## scale: {city.name} ({city.stat().st_size / 1e6:.1f} MB)")
     print(
-        "| buildings | components | types | footprints extruded | rules | grammar lines | time "
-        "| peak memory |"
+        "| buildings | components | types | footprints extruded | houses roofed | rules "
+        "| grammar lines | grammar + assets bytes | time | peak memory |"
     )
-    print("|---|---|---|---|---|---|---|---|")
+    print("|---|---|---|---|---|---|---|---|---|---|")
     if found:
-        b, c, t, x, r = (int(v) for v in found.groups())
+        b, c, t, x, h, r = (int(v or 0) for v in found.groups())
         print(
-            f"| {b:,} | {c:,} | {t:,} | {x:,} | {r:,} | {lines:,} | {seconds:.1f} s | "
-            f"{peak:.0f} MB |"
+            f"| {b:,} | {c:,} | {t:,} | {x:,} | {h:,} | {r:,} | {lines:,} | {size:,} | "
+            f"{seconds:.1f} s | {peak:.0f} MB |"
         )
     print()
 

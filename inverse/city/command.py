@@ -90,12 +90,14 @@ def run(args) -> int:
     placed = grammar.placed
     wrote = "" if output is None else f"; wrote {terminal_text(str(output), keep='')}"
     extruded = sum(t.prism is not None for t in placed.terminals)
-    meshes = len(placed.terminals) - extruded + len(placed.carried)
+    houses = sum(t.house is not None for t in placed.terminals)
+    meshes = len(placed.terminals) - extruded - houses + len(placed.carried)
     print(
         f"{terminal_text(args.input, keep='')}: {len(grammar.scene.objects)} objects, "
         f"{placed.components} components, {len(placed.terminals)} types at level "
-        f"{placed.level.index} ({extruded} footprints extruded), {len(placed.rules)} "
-        f"rules{wrote}"
+        f"{placed.level.index} ({extruded} footprints extruded"
+        + (f", {houses} house{'s' if houses > 1 else ''} roofed" if houses else "")
+        + f"), {len(placed.rules)} rules{wrote}"
         + (
             f" and {meshes} meshes in {terminal_text(str(assets_dir / MESHES), keep='')}"
             if meshes

@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import hashlib
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 import shapely
@@ -76,6 +77,8 @@ class Component:
     colors: np.ndarray | None  # (F, 4) uint8 or None
     key: str  # equal for meshes equal on the key grid (in their chosen frame)
     angle: float  # degrees, the rectangle's rotation about the vertical, in [0, 90)
+    # the walls and roof that make it (houses.HouseFit), for a building that is a house
+    house: Any = None
 
 
 def _turn(angle_deg: float) -> np.ndarray:

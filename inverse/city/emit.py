@@ -14,6 +14,7 @@ import numpy as np
 
 from bgr.grammar import nodes as n
 
+from .houses import HouseFit
 from .prisms import PrismFit
 from .tree import Placement, Rule
 
@@ -33,6 +34,12 @@ class Terminal:
     color: str | None
     comment: str
     prism: PrismFit | None = None  # written as polygon() extrude(), with no asset
+    house: HouseFit | None = None  # written as polygon() extrude() comp(f) { top: roof() }
+
+    @property
+    def operations(self) -> bool:
+        """Whether the type is written as the operations that make it (no asset)."""
+        return self.prism is not None or self.house is not None
 
 
 @dataclass
@@ -143,16 +150,18 @@ def module(
         ),
     )
     own = terminals + [c for c, _ in carried]
-    style = Style(digits, frozenset(t.name for t in own if exact or t.prism is not None))
+    style = Style(digits, frozenset(t.name for t in own if exact or t.operations))
     placed: list[tuple[list[str], n.Item]] = [] if site is None else [([], site)]
-    if any(_split_faces(t.prism) for t in terminals if t.prism is not None):
+    if any(t.house is not None for t in terminals) or any(
+        _split_faces(t.prism) for t in terminals if t.prism is not None
+    ):
         placed.append(([], n.TerminalDecl(list(SURFACES.values()))))
     groups: list[list[tuple[list[str], n.Item]]] = [
         placed,
         [
             ([], n.Asset(t.asset, t.path))
             for t in terminals + [c for c, _ in carried]
-            if t.prism is None
+            if not t.operations
         ],
         [
             (
@@ -188,6 +197,8 @@ def _terminal_rule(t: Terminal, own_size: bool = False, digits: int = 6) -> n.Ru
     CGA), or a footprint's ``polygon() extrude()``; its colour first where it has one."""
     if t.prism is not None:
         return n.Rule(t.name, [], n.Sequence(_prism_steps(t.prism, digits)))
+    if t.house is not None:
+        return n.Rule(t.name, [], n.Sequence(_house_steps(t.house, digits)))
     steps: list = [n.Operation("i", [n.Name(t.asset)])]
     if own_size:
         steps.insert(0, n.Operation("s", [n.Number(0.0)] * 3))
@@ -220,6 +231,29 @@ def _prism_steps(prism: PrismFit, digits: int) -> list:
         entries.append(n.Entry("abs", n.Name(part), n.Sequence(body)))
     steps.append(n.Operation("comp", [n.Name("f")], n.Block(entries)))
     return steps
+
+
+def _house_steps(house: HouseFit, digits: int) -> list:
+    """``polygon(...) extrude(h) comp(f) { top: roof(kind, pitch, overhang) Roof | side: Wall
+    | bottom: Ground }``, the floor where the building has one, each part in its colour."""
+    corners = [num(c, digits) for corner in house.ring for c in corner]
+    roof_args: list = [n.Name(house.kind), num(house.pitch, 3)]
+    if house.overhang > 0:
+        roof_args.append(num(house.overhang, digits))
+    parts = [("top", "roof", [n.Operation("roof", roof_args)]), ("side", "side", [])]
+    if house.bottom:
+        parts.append(("bottom", "bottom", []))
+    entries = []
+    for face, part, steps in parts:
+        paint = house.colors.get(part)
+        body: list = steps + ([n.Operation("color", [n.String(paint)])] if paint else [])
+        body.append(n.Successor(SURFACES[face]))
+        entries.append(n.Entry("abs", n.Name(face), n.Sequence(body)))
+    return [
+        n.Operation("polygon", corners),
+        n.Operation("extrude", [num(house.height, digits)]),
+        n.Operation("comp", [n.Name("f")], n.Block(entries)),
+    ]
 
 
 def _parts(prism: PrismFit) -> list[str]:

@@ -27,6 +27,7 @@ from .batch import building_stacks, decompose_all
 from .carried import Carried, carry
 from .components import TOLERANCE, Component, digits_for, grid_mesh, key_grid
 from .container import Mesh, pack
+from .houses import roofed
 from .model import CityScene
 from .prisms import fit_prism
 from .types import Level, Types, cluster, level_for
@@ -129,6 +130,7 @@ def place(
     if level.index == 0:
         key = key_grid(options.tolerance)
         comps, types = uncut_unique(scene.objects, comps, types, options.tolerance, key)
+        comps, types = roofed(scene.objects, comps, types, options.tolerance, key)
         level = types.levels[0]
     of_comp = level.of_base[types.base_of]
     count = np.bincount(of_comp, minlength=len(level.representative))
@@ -142,7 +144,8 @@ def place(
         # a type whose instances are all its representative's size may be written as the
         # operations that make it; one whose instances differ is a mesh fitted to each box
         same = bool(np.all(high - low <= key_grid(options.tolerance)))
-        prism = fit_prism(rep, options.tolerance) if same else None
+        house = rep.house if same else None
+        prism = fit_prism(rep, options.tolerance) if same and house is None else None
         span = " x ".join(
             f"{a:.1f}" if abs(a - b) < 0.05 else f"{a:.1f}-{b:.1f}"
             for a, b in zip(low, high, strict=True)
@@ -156,9 +159,10 @@ def place(
                 # an extrusion's numbers say its size; a mesh's comment says it
                 ", ".join(
                     ([f"{count[t]} instances"] if count[t] > 1 else [])
-                    + ([] if prism else [f"{span} m"])
+                    + ([] if prism or house else [f"{span} m"])
                 ),
                 prism,
+                house,
             )
         )
         term_mesh.append(rep)
@@ -378,7 +382,7 @@ def build(
         digits = min(digits, tree.level_digits(placed.level.index))
     with _bar(options, len(placed.terminals) + len(placed.carried), "writing meshes") as bar:
         for t, rep in zip(placed.terminals, placed.term_mesh, strict=True):
-            if t.prism is None:  # a footprint extruded is written as operations, not a mesh
+            if not t.operations:  # a footprint extruded (and roofed) is written as operations
                 named.append(Mesh(t.asset, *grid_mesh(rep.vertices, rep.faces, digits)))
             bar.update()
         for kind in placed.carried:
@@ -409,13 +413,20 @@ def build(
 
 def _header(scene: CityScene, comps: list[Component], types: Types, placed: Placed) -> list[str]:
     extruded = sum(t.prism is not None for t in placed.terminals)
+    roofed_types = sum(t.house is not None for t in placed.terminals)
     lines = [
         f"# Inferred by bgr infer --kind city from {comment_text(Path(scene.source).name)}: "
         f"{len(scene.objects)} objects,",
         f"# {placed.components} components in {len(placed.terminals)} types (level "
         f"{placed.level.index} of {len(types.levels) - 1}), {len(placed.rules)} non-terminal "
         "rules;",
-        f"# {extruded} of the types are footprints extruded (polygon, extrude), the others meshes;",
+        f"# {extruded} of the types are footprints extruded (polygon, extrude), "
+        + (
+            f"{roofed_types} house{'s' if roofed_types > 1 else ''} (polygon, extrude, roof), "
+            if roofed_types
+            else ""
+        )
+        + "the others meshes;",
         "# a mesh type's comment gives its size (width x height x depth), and any type's its "
         "instances where several.",
     ]

@@ -120,11 +120,16 @@ def prism_mesh(fit: PrismFit) -> trimesh.Trimesh:
 
 
 def _close(comp: Component, fit: PrismFit, tolerance: float) -> bool:
-    """Whether the prism and the component are within ``tolerance`` of each other both ways,
+    """Whether the prism and the component are within ``tolerance`` of each other both ways
+    (:func:`_close_meshes`)."""
+    given = trimesh.Trimesh(comp.vertices, comp.faces, process=False)
+    return _close_meshes(given, prism_mesh(fit), tolerance)
+
+
+def _close_meshes(given: trimesh.Trimesh, made: trimesh.Trimesh, tolerance: float) -> bool:
+    """Whether two meshes are within three quarters of ``tolerance`` of each other both ways,
     on their vertices and on points spread over their surfaces (at most SPACING apart where
     SAMPLES allow) — trimesh's point-to-surface distance."""
-    made = prism_mesh(fit)
-    given = trimesh.Trimesh(comp.vertices, comp.faces, process=False)
     for a, b in ((given, made), (made, given)):
         count = int(min(SAMPLES, max(64, a.area / SPACING**2)))
         points, _ = trimesh.sample.sample_surface(a, count, seed=0)
