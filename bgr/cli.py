@@ -20,7 +20,7 @@ import traceback
 
 from . import __version__
 from .cga import command as import_cga
-from .commands import check, derive, fmt, infer, lsp, render, restyle, retarget
+from .commands import check, derive, fmt, infer, lsp, render, restyle, retarget, serve
 from .commands.common import EXIT_INPUT, EXIT_INTERRUPTED, EXIT_OK, EXIT_TERMINATED, EXIT_USAGE
 from .commands.options import address_space_restored
 from .formats.atomic import Terminated, on_sigterm, reset_termination
@@ -38,6 +38,7 @@ COMMANDS = {
     "fmt": fmt,
     "import-cga": import_cga,
     "lsp": lsp,
+    "serve": serve,
 }
 
 # what main()'s out-of-memory message advises besides --max-memory, by command
