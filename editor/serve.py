@@ -4,8 +4,9 @@ A small ASGI app (starlette, run by uvicorn; chosen over aiohttp for its test cl
 exercises the routes without a socket, and because uvicorn's websockets are the ones the page
 needs) on 127.0.0.1 by default:
 
-* ``/`` the page (``editor/static/``: three.js, vendored, shows ``/model.glb``);
-* ``/ws`` a websocket telling the page of each new model (or error) as it is derived;
+* ``/`` the page (``editor/static/``: three.js, vendored); ``/model.glb`` the model;
+* ``/ws`` a websocket pushing each new model as it is derived (a JSON message, then the GLB's
+  bytes), or the error that stopped it;
 * ``/state`` the file, its attrs (with their ``@Range``/``@Enum`` metadata) and the settings;
 * ``/settings`` (POST) new attr values, seed or lot feature: derived again;
 * ``/pick?x=&y=&z=`` the terminal at a point of the model: its label, rule path and attrs;
@@ -105,9 +106,15 @@ class Server:
             self._watch_imports()
         for socket in list(session.sockets):
             try:
-                await socket.send_json(message)
+                await self._send(socket, message)
             except Exception:  # a closed page: forget it
                 session.sockets.discard(socket)
+
+    async def _send(self, socket: WebSocket, message: dict) -> None:
+        """A message to a page; a model's is followed by the GLB itself, as bytes."""
+        await socket.send_json(message)
+        if message["type"] == "model" and self.session.model is not None:
+            await socket.send_bytes(self.session.model.glb)
 
     def _model_message(self) -> dict:
         model = self.session.model
@@ -271,7 +278,7 @@ class Server:
         self.session.sockets.add(websocket)
         try:
             if self.session.model is not None:
-                await websocket.send_json(self._model_message())
+                await self._send(websocket, self._model_message())
             if self.session.error is not None:
                 await websocket.send_json({"type": "error", "errors": self.session.error.errors})
             while True:

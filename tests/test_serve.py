@@ -171,3 +171,50 @@ def test_a_runaway_derivation_is_stopped_and_the_server_goes_on(tmp_path):
         grammar.write_text("terminal A\nLot --> extrude(3) A\n")
         wait_for(lambda: client.get("/state").json()["version"] >= 1, 20)
         assert client.get("/state").json()["errors"] == []
+
+
+def test_saving_an_imported_file_derives_again_and_the_socket_pushes_the_glb(tmp_path):
+    (tmp_path / "parts").mkdir()
+    part = tmp_path / "parts" / "block.bgr"
+    part.write_text("terminal A\nattr h = 3\nBlock --> extrude(h) A\n")
+    grammar = tmp_path / "main.bgr"
+    grammar.write_text('import "parts/block.bgr" as b\nLot --> b.Block\n')
+    server = Server(Request(str(grammar)))
+    with TestClient(server.app()) as client, client.websocket_connect("/ws") as socket:
+        first = socket.receive_json()
+        assert first["type"] == "model" and socket.receive_bytes()[:4] == b"glTF"
+        part.write_text("terminal A\nattr h = 9\nBlock --> extrude(h) A\n")
+        second = socket.receive_json()
+        assert second["type"] == "model" and second["version"] == first["version"] + 1
+        glb = socket.receive_bytes()
+        assert glb == client.get("/model.glb").content
+
+
+def test_the_lot_picker_derives_one_footprint(tmp_path):
+    import json
+
+    features = [
+        {
+            "type": "Feature",
+            "id": name,
+            "properties": {},
+            "geometry": {
+                "type": "Polygon",
+                "coordinates": [[[x, 0], [x + 10, 0], [x + 10, 8], [x, 8], [x, 0]]],
+            },
+        }
+        for name, x in (("left", 1000), ("right", 1030))
+    ]
+    lots = tmp_path / "lots.geojson"
+    lots.write_text(json.dumps({"type": "FeatureCollection", "features": features}))
+    grammar = tmp_path / "block.bgr"
+    grammar.write_text("terminal A\nLot --> extrude(5) A\n")
+    server = Server(Request(str(grammar), lot=str(lots)))
+    with TestClient(server.app()) as client:
+        state = wait_for(lambda: (s := client.get("/state").json())["version"] >= 1 and s)
+        assert state["features"] == ["left", "right"]
+        both = client.get("/state").json()["model"]["terminals"]
+        client.post("/settings", json={"feature": 1})
+        wait_for(lambda: client.get("/state").json()["version"] >= 2, 10)
+        state = client.get("/state").json()
+        assert state["feature"] == 1 and state["model"]["terminals"] == both / 2

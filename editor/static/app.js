@@ -47,10 +47,7 @@ function frame(object) {
   controls.target.copy(centre);
 }
 
-async function loadModel(message) {
-  const response = await fetch(`/model.glb?v=${message.version}`, { cache: "no-store" });
-  if (!response.ok) return;
-  const data = await response.arrayBuffer();
+async function showModel(message, data) {
   const gltf = await loader.parseAsync(data, "");
   if (model) {
     scene.remove(model);
@@ -105,9 +102,16 @@ function setStatus(text) {
 
 function connect() {
   const socket = new WebSocket(`ws://${location.host}/ws`);
+  socket.binaryType = "arraybuffer";
+  let announced = null; // a model message: its GLB comes next, as bytes
   socket.onmessage = (event) => {
+    if (typeof event.data !== "string") {
+      if (announced) showModel(announced, event.data);
+      announced = null;
+      return;
+    }
     const message = JSON.parse(event.data);
-    if (message.type === "model") loadModel(message);
+    if (message.type === "model") announced = message;
     else if (message.type === "error") showErrors(message.errors);
   };
   socket.onclose = () => setTimeout(connect, 1000); // the server restarted: come back
