@@ -46,13 +46,13 @@ from .prisms import (
     PrismFit,
     _close_meshes,
     _colors,
-    _ground_lines,
-    _outline,
-    _rounded,
+    facing,
     fit_prism,
+    footprint,
     prism_mesh,
 )
-from .types import Types, base_types
+from .types import Types
+from .uncut import whole_instead
 
 KINDS = ("gable", "hip", "pyramid", "shed")
 PITCH_DIGITS = 3  # degrees: a thousandth moves a 10 m roof's ridge by under a millimetre
@@ -106,21 +106,13 @@ def roofed(
             instead[b] = replace(house, building=b, frame=comp.frame @ turn)
     if not instead:
         return comps, types
-    out: list[Component] = []
-    for i, comp in enumerate(comps):
-        if comp.building not in instead:
-            out.append(comp)
-        elif i == members[comp.building][0]:
-            out.append(instead[comp.building])
-    return out, base_types(out)
+    return whole_instead(comps, members, instead)
 
 
 def _has_slopes(comp: Component) -> bool:
     """Whether some face of the component is neither upright nor level (a roof's slope)."""
-    tri = comp.vertices[comp.faces]
-    cross = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
-    length = np.linalg.norm(cross, axis=1)
-    up = np.abs(np.divide(cross[:, 1], length, out=np.zeros(len(tri)), where=length > 1e-12))
+    _, _, up = facing(comp.vertices[comp.faces])
+    up = np.abs(up)
     return bool(np.any((up >= UPRIGHT) & (up <= LEVEL)))
 
 
@@ -155,21 +147,15 @@ def _fit(comp: Component, tolerance: float) -> Component | None:
     if len(f) == 0 or comp.size[1] < MIN_HEIGHT:
         return None
     tri = v[f]
-    cross = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
-    double = np.linalg.norm(cross, axis=1)
-    real = double > 1e-12
-    up = np.divide(cross[:, 1], double, out=np.zeros(len(f)), where=real)
+    _, real, up = facing(tri)
     half = tolerance / 2
     wall = real & (np.abs(up) < UPRIGHT)
     floor = real & (up < -LEVEL) & (np.abs(tri[:, :, 1]).max(axis=1) <= half)
     sloped = real & (up >= UPRIGHT)
     if not wall.any() or not sloped.any() or np.any(real & ~(wall | floor | sloped)):
         return None  # no roof, or a face looking down that is not the floor (a soffit)
-    outline = _outline(_ground_lines(tri[wall], half), tolerance)
-    if outline is None:
-        return None
     digits = digits_for(tolerance)
-    ring = _rounded(outline, digits)
+    ring = footprint(tri[wall], tolerance)
     if ring is None:
         return None
     height = _wall_height(tri[wall], np.array(ring), half)

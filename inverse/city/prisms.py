@@ -58,10 +58,7 @@ def _fit(comp: Component, tolerance: float) -> PrismFit | None:
     if len(f) == 0 or height < MIN_HEIGHT:
         return None
     tri = v[f]
-    cross = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
-    double = np.linalg.norm(cross, axis=1)
-    real = double > 1e-12
-    up = np.divide(cross[:, 1], double, out=np.zeros(len(f)), where=real)
+    double, real, up = facing(tri)
     ys = tri[:, :, 1]
     half = tolerance / 2
     wall = real & (np.abs(up) < UPRIGHT)
@@ -69,11 +66,8 @@ def _fit(comp: Component, tolerance: float) -> PrismFit | None:
     top = real & (up > LEVEL) & (np.abs(ys - height).max(axis=1) <= half)
     if not np.all(wall | bottom | top | ~real) or not wall.any():
         return None
-    outline = _outline(_ground_lines(tri[wall], half), tolerance)
-    if outline is None:
-        return None
     digits = digits_for(tolerance)
-    ring = _rounded(outline, digits)
+    ring = footprint(tri[wall], tolerance)
     if ring is None:
         return None
     polygon = shapely.Polygon(ring)
@@ -106,6 +100,22 @@ def _fit(comp: Component, tolerance: float) -> PrismFit | None:
         return None
     fit = PrismFit(ring, round(height, digits), caps["bottom"], caps["top"], colors)
     return fit if _close(comp, fit, tolerance) else None
+
+
+def facing(tri: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(twice each triangle's area, whether it has any, the upward part of its unit normal)."""
+    cross = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
+    double = np.linalg.norm(cross, axis=1)
+    real = double > 1e-12
+    up = np.divide(cross[:, 1], double, out=np.zeros(len(tri)), where=real)
+    return double, real, up
+
+
+def footprint(walls: np.ndarray, tolerance: float) -> tuple[tuple[float, float], ...] | None:
+    """Where the walls stand seen from above, as one ring on the grammar's grid, or None when
+    they enclose no single polygon without a courtyard."""
+    outline = _outline(_ground_lines(walls, tolerance / 2), tolerance)
+    return None if outline is None else _rounded(outline, digits_for(tolerance))
 
 
 def prism_mesh(fit: PrismFit) -> trimesh.Trimesh:

@@ -45,7 +45,14 @@ def uncut_unique(
     fitted = fit_all(
         [(b, s) for b, s in zip(whole, slabs, strict=True) if s is not None], objects, grid
     )
-    instead = {c.building: c for c in fitted}
+    return whole_instead(comps, members, {c.building: c for c in fitted})
+
+
+def whole_instead(
+    comps: list[Component], members: dict[int, list[int]], instead: dict[int, Component]
+) -> tuple[list[Component], Types]:
+    """``comps`` with the components of each building of ``instead`` replaced by its one
+    component there, where its lowest was; and their level-0 types."""
     out: list[Component] = []
     for i, comp in enumerate(comps):
         if comp.building not in instead:
