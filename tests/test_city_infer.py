@@ -173,10 +173,12 @@ def test_a_lossy_level_writes_lengths_no_finer_than_it_moves_things(tmp_path):
 
     _, fine = infer_scene(scene, tmp_path)
     _, coarse = infer_scene(scene, tmp_path, level=3)
-    assert decimals(fine) == 3 and decimals(coarse) == 2
+    assert decimals(fine) == 3 and decimals(coarse) == 1
+    turns = re.findall(r"\br\(0, -?\d+\.(\d+), 0\)", coarse)
+    assert all(len(d) == 1 for d in turns)  # degrees to a tenth, as the lengths' decimetres
     from bgr.inverse.city.tree import level_digits
 
-    assert [level_digits(level) for level in range(1, 9)] == [3, 3, 2, 2, 2, 2, 1, 1]
+    assert [level_digits(level) for level in range(1, 9)] == [2, 2, 1, 1, 1, 1, 1, 1]
 
 
 # ---- editing ----------------------------------------------------------------------------------
